@@ -1,0 +1,67 @@
+// Format dispatch by file extension.
+#include <algorithm>
+#include <filesystem>
+
+#include "core/error.h"
+#include "io/reader.h"
+#include "io/writer.h"
+
+namespace fibscope {
+namespace {
+
+std::string extensionOf(const std::string& path) {
+  std::string p = path;
+  while (p.size() > 1 && p.back() == '/') p.pop_back();
+  std::string ext = std::filesystem::path(p).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext;
+}
+
+}  // namespace
+
+std::unique_ptr<TractogramReader> openTractogram(const std::string& path) {
+  const std::string ext = extensionOf(path);
+  if (ext == ".tck") return openTck(path);
+  if (ext == ".trk") return openTrk(path);
+  if (ext == ".trx") return openTrx(path);
+  if (ext == ".vtk") return openVtk(path);
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec) && std::filesystem::exists(std::filesystem::path(path) / "header.json", ec))
+    return openTrx(path);
+  fail(path, "unknown tractogram format '" + ext + "' (expected .tck, .trk, .trx or .vtk)");
+}
+
+Tractogram readTractogram(const std::string& path, TractogramHeader* header, std::vector<std::string>* warnings) {
+  auto reader = openTractogram(path);
+  Tractogram all;
+  for (const auto& a : reader->header().per_streamline) all.per_streamline.push_back({a.name, a.components, a.dtype, {}});
+  for (const auto& a : reader->header().per_point) all.per_point.push_back({a.name, a.components, a.dtype, {}});
+  Tractogram chunk;
+  while (reader->read(chunk)) all.append(chunk);
+  if (header) *header = reader->header();
+  if (warnings) warnings->insert(warnings->end(), reader->warnings().begin(), reader->warnings().end());
+  return all;
+}
+
+std::unique_ptr<TractogramWriter> createTractogramWriter(const std::string& path, const TractogramHeader& like,
+                                                         const WriterOptions& options) {
+  const std::string ext = extensionOf(path);
+  if (ext == ".tck") return createTckWriter(path, like, options);
+  if (ext == ".trk") return createTrkWriter(path, like, options);
+  if (ext == ".trx") {
+    WriterOptions o = options;
+    if (!path.empty() && path.back() == '/') o.trx_zip = false;
+    return createTrxWriter(path, like, o);
+  }
+  fail(path, "cannot write format '" + ext + "' (writable: .tck, .trk, .trx)");
+}
+
+void writeTractogram(const std::string& path, const Tractogram& tractogram, const TractogramHeader& like,
+                     const WriterOptions& options, std::vector<std::string>* warnings) {
+  auto writer = createTractogramWriter(path, like, options);
+  writer->write(tractogram);
+  writer->finish();
+  if (warnings) warnings->insert(warnings->end(), writer->warnings().begin(), writer->warnings().end());
+}
+
+}  // namespace fibscope

@@ -1,0 +1,59 @@
+// Streaming tractogram writers.
+//
+// A writer is created with a header that announces the data arrays, takes
+// chunks in order and writes the file under a temporary name; finish()
+// completes the header (counts) and renames the file into place. A writer
+// destroyed without finish() leaves no file behind. What the target format
+// cannot carry (per-streamline data in tck, groups in trk, ...) is dropped
+// and said once in warnings().
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/tractogram.h"
+
+namespace fibscope {
+
+struct WriterOptions {
+  bool overwrite = false;          // --force
+  // trx: "float16", "float32" or "float64" positions; zip or directory.
+  std::string trx_position_dtype = "float32";
+  bool trx_zip = true;             // false: write a TRX directory
+  // tck: "Float32LE" (MRtrix default), "Float32BE", "Float64LE", "Float64BE".
+  std::string tck_datatype = "Float32LE";
+};
+
+class TractogramWriter {
+ public:
+  virtual ~TractogramWriter() = default;
+  // Appends the streamlines of `chunk` (its data arrays must match the header).
+  virtual void write(const Tractogram& chunk) = 0;
+  // Completes and renames the output. Must be called exactly once.
+  virtual void finish() = 0;
+  const std::vector<std::string>& warnings() const { return warnings_; }
+
+ protected:
+  void warn(const std::string& message) { warnings_.push_back(message); }
+  std::vector<std::string> warnings_;
+};
+
+// Creates a writer by the extension of `path` (.tck, .trk, .trx; a path
+// ending in '/' or with trx_zip=false writes a TRX directory). `like` gives
+// the data arrays, space (trk/trx voxel grid) and properties to carry over.
+std::unique_ptr<TractogramWriter> createTractogramWriter(const std::string& path, const TractogramHeader& like,
+                                                         const WriterOptions& options = {});
+
+// Writes a whole tractogram (tests, small files).
+void writeTractogram(const std::string& path, const Tractogram& tractogram, const TractogramHeader& like,
+                     const WriterOptions& options = {}, std::vector<std::string>* warnings = nullptr);
+
+std::unique_ptr<TractogramWriter> createTckWriter(const std::string& path, const TractogramHeader& like,
+                                                  const WriterOptions& options);
+std::unique_ptr<TractogramWriter> createTrkWriter(const std::string& path, const TractogramHeader& like,
+                                                  const WriterOptions& options);
+std::unique_ptr<TractogramWriter> createTrxWriter(const std::string& path, const TractogramHeader& like,
+                                                  const WriterOptions& options);
+
+}  // namespace fibscope

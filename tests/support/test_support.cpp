@@ -1,0 +1,92 @@
+#include "test_support.h"
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+namespace fibscope::test {
+
+TempDir::TempDir() {
+  const char* base = std::getenv("TMPDIR");
+  std::string templ = std::string(base && *base ? base : "/tmp") + "/fibscope-test-XXXXXX";
+  if (!::mkdtemp(templ.data())) throw std::runtime_error("mkdtemp failed");
+  path_ = templ;
+}
+
+TempDir::~TempDir() {
+  std::error_code ec;
+  std::filesystem::remove_all(path_, ec);
+}
+
+CommandResult runCommand(const std::string& command_line) {
+  CommandResult r;
+  FILE* pipe = ::popen((command_line + " 2>&1").c_str(), "r");
+  if (!pipe) return r;
+  char buf[4096];
+  size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, pipe)) > 0) r.output.append(buf, n);
+  const int status = ::pclose(pipe);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+  return r;
+}
+
+CommandResult runFibscope(const std::string& args) { return runCommand(std::string(FIBSCOPE_EXE) + " " + args); }
+
+std::string pythonWithNibabel() {
+  for (const char* py : {"/usr/bin/python3", "python3"}) {
+    if (runCommand(std::string(py) + " -c 'import nibabel, numpy'").exit_code == 0) return py;
+  }
+  return {};
+}
+
+std::string toolPath(const std::string& name) { return std::string(FIBSCOPE_TEST_TOOLS_DIR) + "/" + name; }
+
+void writeBytes(const std::string& path, const std::string& bytes) {
+  std::ofstream f(path, std::ios::binary);
+  f.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+std::string readBytes(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+Tractogram smallTractogram(size_t streamlines, unsigned seed, bool with_data) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(-1.f, 1.f);
+  std::uniform_int_distribution<int> len(2, 60);
+  Tractogram t;
+  if (with_data) {
+    t.per_streamline.push_back({"weight", 1, "float32", {}});
+    t.per_point.push_back({"fa", 1, "float32", {}});
+  }
+  for (size_t s = 0; s < streamlines; ++s) {
+    const int n = len(rng);
+    float p[3] = {50 * u(rng), 50 * u(rng), 50 * u(rng)};
+    float d[3] = {u(rng), u(rng), u(rng)};
+    std::vector<float> xyz;
+    for (int i = 0; i < n; ++i) {
+      const float norm = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) + 1e-6f;
+      for (int k = 0; k < 3; ++k) {
+        xyz.push_back(p[k]);
+        p[k] += 0.5f * d[k] / norm;
+        d[k] += 0.2f * u(rng);
+      }
+      if (with_data) t.per_point[0].values.push_back(0.5f + 0.5f * u(rng));
+    }
+    t.addStreamline(xyz.data(), n);
+    if (with_data) t.per_streamline[0].values.push_back(float(s) * 0.25f);
+  }
+  return t;
+}
+
+}  // namespace fibscope::test

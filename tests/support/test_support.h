@@ -1,0 +1,47 @@
+// Helpers shared by the tests: temporary directories, running the fibscope
+// executable and helper scripts, small synthetic tractograms.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/tractogram.h"
+
+namespace fibscope::test {
+
+// A fresh directory under $TMPDIR, removed with its contents on destruction.
+class TempDir {
+ public:
+  TempDir();
+  ~TempDir();
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  const std::string& path() const { return path_; }
+  std::string file(const std::string& name) const { return path_ + "/" + name; }
+
+ private:
+  std::string path_;
+};
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+// Runs a shell command line and captures its output.
+CommandResult runCommand(const std::string& command_line);
+// Runs the built fibscope executable with `args` (already shell-quoted).
+CommandResult runFibscope(const std::string& args);
+// Path of the Python interpreter that has Debian's nibabel, "" if none.
+std::string pythonWithNibabel();
+// Path of a script in tests/tools.
+std::string toolPath(const std::string& name);
+
+void writeBytes(const std::string& path, const std::string& bytes);
+std::string readBytes(const std::string& path);
+
+// A small deterministic tractogram: `streamlines` curved fibers of 2..60
+// points in a 100 mm box, with optional data arrays.
+Tractogram smallTractogram(size_t streamlines, unsigned seed = 1, bool with_data = false);
+
+}  // namespace fibscope::test
