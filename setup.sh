@@ -1,0 +1,63 @@
+#!/usr/bin/env bash
+# fibscope set-up for a fresh Debian 12 machine.
+#   ./setup.sh run    install what is missing, build, run the main job
+#   ./setup.sh test   install what is missing, build, run every test
+# Both are idempotent: installed packages and an up-to-date build are skipped.
+set -euo pipefail
+cd "$(dirname "$0")"
+
+mode=${1:-run}
+case "$mode" in run|test) ;; *) echo "usage: $0 run|test" >&2; exit 2 ;; esac
+
+# Build and run-time packages (Debian 12 names).
+packages=(g++ cmake ninja-build pkg-config libgtest-dev libbenchmark-dev libcli11-dev
+          nlohmann-json3-dev libzip-dev zlib1g-dev)
+# Independent references for the tests (nibabel, MRtrix3) and the fuzzers (clang, libFuzzer).
+if [ "$mode" = test ]; then
+  packages+=(python3 python3-numpy python3-nibabel mrtrix3 clang libclang-rt-14-dev)
+fi
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  if [ "$(id -u)" -eq 0 ]; then
+    echo "setup: installing ${missing[*]}"
+    export DEBIAN_FRONTEND=noninteractive
+    apt-get update -qq
+    apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+  else
+    echo "setup: missing packages; run as root:" >&2
+    echo "  apt-get install -y --no-install-recommends ${missing[*]}" >&2
+    exit 1
+  fi
+fi
+
+jobs=$(nproc)
+configure() {  # configure DIR [cmake args...] unless already configured
+  local dir=$1; shift
+  [ -f "$dir/build.ninja" ] || cmake -S . -B "$dir" -G Ninja "$@" >/dev/null
+}
+
+configure build -DCMAKE_BUILD_TYPE=RelWithDebInfo
+ninja -C build -j "$jobs" --quiet
+
+if [ "$mode" = run ]; then
+  mkdir -p out
+  [ -f out/phantom.tck ] || ./build/fibscope phantom out/phantom.tck --streamlines 20000 --seed 1
+  ./build/fibscope info out/phantom.tck
+  exit 0
+fi
+
+# Tests: the optimised build, then the same tests under ASan + UBSan.
+export FIBSCOPE_TEST_PYTHON=/usr/bin/python3
+status=0
+(cd build && ctest --output-on-failure -j "$jobs" --timeout 600) || status=1
+configure build-asan -DCMAKE_BUILD_TYPE=Debug -DFIBSCOPE_SANITIZE=ON -DFIBSCOPE_BENCH=OFF
+ninja -C build-asan -j "$jobs" --quiet
+(cd build-asan && ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+   ctest --output-on-failure -j "$jobs" --timeout 900) || status=1
+# Every reader's fuzzer for a fixed number of runs (deterministic seed).
+scripts/fuzz.sh --runs 20000 || status=1
+exit $status
