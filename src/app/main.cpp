@@ -1,16 +1,35 @@
 // fibscope command line: wires the subcommands together.
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <exception>
 
+#include "app/commands.h"
 #include "core/error.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"fibscope: real-time whole-brain tractogram viewer and tools"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", "fibscope 0.1.0");
+  fibscope::addInfoCommand(app);
+  fibscope::addConvertCommand(app);
+  fibscope::addPhantomCommand(app);
   try {
     app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
+  } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return 2;
+  } catch (const fibscope::Error& e) {
+    std::fprintf(stderr, "fibscope: error: %s\n", e.what());
+    return 2;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "fibscope: error: out of memory\n");
+    return 2;
   }
   return 0;
 }
