@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <unordered_set>
 
 #include "core/byte_order.h"
 #include "core/error.h"
@@ -255,17 +256,18 @@ std::vector<TrkNamedRun> decodeTrkNames(const std::array<std::array<char, kTrkNa
   // Components without a name (n_scalars larger than the names account for).
   for (uint32_t k = next; k < uint32_t(count); ++k) runs.push_back({unnamed_prefix + "_" + std::to_string(k), k, 1});
 
-  // Empty and duplicate names would be ambiguous downstream.
-  for (size_t i = 0; i < runs.size(); ++i) {
-    if (runs[i].name.empty()) runs[i].name = unnamed_prefix + "_" + std::to_string(runs[i].first);
-    for (size_t j = 0; j < i; ++j)
-      if (runs[j].name == runs[i].name) {
-        const std::string renamed = runs[i].name + "_" + std::to_string(runs[i].first);
-        warnings.push_back(what + " name '" + runs[i].name + "' appears twice; the second is read as '" + renamed +
-                           "'");
-        runs[i].name = renamed;
-        j = std::size_t(-1);  // check the new name against all earlier ones
-      }
+  // Empty and duplicate names would be ambiguous downstream. (A hash set:
+  // n_scalars may be 32767, all unnamed.)
+  std::unordered_set<std::string> used;
+  for (TrkNamedRun& run : runs) {
+    if (run.name.empty()) run.name = unnamed_prefix + "_" + std::to_string(run.first);
+    if (used.count(run.name)) {
+      std::string renamed = run.name + "_" + std::to_string(run.first);
+      while (used.count(renamed)) renamed += "_";
+      warnings.push_back(what + " name '" + run.name + "' appears twice; the second is read as '" + renamed + "'");
+      run.name = renamed;
+    }
+    used.insert(run.name);
   }
   return runs;
 }
