@@ -52,6 +52,11 @@ Tractogram readTractogram(const std::string& path, TractogramHeader* header = nu
 
 // Format-specific openers, for tests and for callers that know the format.
 std::unique_ptr<TractogramReader> openTck(const std::string& path);
+// A .tck with MRtrix track scalar files (.tsf) attached: each becomes a
+// one-component per-point array named after its file stem ("fa.tsf" -> "fa").
+// Their streamline and point counts must match the .tck (Error naming the
+// .tsf, the byte offset and the streamline index otherwise).
+std::unique_ptr<TractogramReader> openTck(const std::string& path, const std::vector<std::string>& tsf_paths);
 std::unique_ptr<TractogramReader> openTrk(const std::string& path);
 std::unique_ptr<TractogramReader> openTrx(const std::string& path);
 std::unique_ptr<TractogramReader> openVtk(const std::string& path);
