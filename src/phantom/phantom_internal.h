@@ -1,0 +1,152 @@
+// Internals of the phantom generator shared by its translation units: a small
+// double vector, the per-streamline random stream, the guide curve a fiber
+// follows and the tracker that walks along it.
+//
+// Nothing here is public API; include phantom.h instead.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "phantom/phantom.h"
+
+namespace fibscope::phantom_detail {
+
+inline constexpr double kPi = 3.14159265358979323846;
+inline double radians(double degrees) { return degrees * (kPi / 180.0); }
+
+struct Vec3 {
+  double x = 0, y = 0, z = 0;
+};
+inline Vec3 operator+(Vec3 a, Vec3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+inline Vec3 operator-(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+inline Vec3 operator*(double s, Vec3 a) { return {s * a.x, s * a.y, s * a.z}; }
+inline double dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline Vec3 cross(Vec3 a, Vec3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+inline double norm(Vec3 a) { return std::sqrt(dot(a, a)); }
+inline Vec3 normalized(Vec3 a) { return (1.0 / norm(a)) * a; }
+inline Vec3 lerp(Vec3 a, Vec3 b, double t) { return a + t * (b - a); }
+inline double lerp(double a, double b, double t) { return a + t * (b - a); }
+inline double smoothstep(double edge0, double edge1, double x) {
+  double t = (x - edge0) / (edge1 - edge0);
+  t = t < 0 ? 0 : (t > 1 ? 1 : t);
+  return t * t * (3 - 2 * t);
+}
+
+// SplitMix64 finaliser (Steele, Lea, Flood 2014): a bijective 64-bit mix
+// whose outputs pass BigCrush for consecutive inputs. Used both to derive a
+// streamline's key from (seed, index, attempt) and as that streamline's
+// sequential stream, which makes streamline i a pure function of
+// (options, seed, i): no state is shared between streamlines or threads.
+inline uint64_t mix64(uint64_t z) {
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  return z ^ (z >> 31);
+}
+
+class Rng {
+ public:
+  explicit Rng(uint64_t key) : state_(key) {}
+  uint64_t next() {
+    state_ += 0x9e3779b97f4a7c15ull;
+    return mix64(state_);
+  }
+  // Uniform in [0, 1) with 53 random bits.
+  double uniform() { return double(next() >> 11) * 0x1.0p-53; }
+  double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
+  // Approximately standard normal: the Irwin-Hall sum of four 16-bit uniforms
+  // taken from one 64-bit draw, centred and scaled to unit variance. Its
+  // support is bounded (|g| <= 2 * sqrt(3) = 3.46), which keeps the tracker's
+  // jitter from ever producing a wild outlier, and it costs a few integer
+  // operations instead of a log and a sqrt (Box-Muller).
+  double normal() {
+    const uint64_t r = next();
+    const uint64_t pairs = (r & 0x0000ffff0000ffffull) + ((r >> 16) & 0x0000ffff0000ffffull);
+    const double sum = double((pairs & 0xffffffffull) + (pairs >> 32));
+    // mean 4 * 65535 / 2, variance 4 * (65536^2 - 1) / 12
+    return (sum - 131070.0) * (1.0 / 37837.22692);
+  }
+
+ private:
+  uint64_t state_;
+};
+
+// Key of the random stream of streamline `index`, retry `attempt`.
+inline uint64_t streamlineKey(uint64_t seed, uint64_t index, uint32_t attempt) {
+  uint64_t k = mix64(seed + 0x5851f42d4c957f2dull);
+  k = mix64(k ^ (index + 0x9e3779b97f4a7c15ull));
+  return mix64(k ^ (uint64_t(attempt) * 0xd1b54a32d192ed03ull + 0x2545f4914f6cdd1dull));
+}
+
+// The ellipsoid of the phantom: (x/a)^2 + (y/b)^2 + (z/c)^2 <= 1.
+inline double ellipsoidMeasure(double x, double y, double z) {
+  const double u = x / kPhantomSemiAxesMm[0], v = y / kPhantomSemiAxesMm[1], w = z / kPhantomSemiAxesMm[2];
+  return u * u + v * v + w * w;
+}
+// Relative radius: 1 on the surface, 0.9 at 90% of the way from the centre.
+inline double relativeRadius(Vec3 p) { return std::sqrt(ellipsoidMeasure(p.x, p.y, p.z)); }
+// `p` moved along the ray from the centre to relative radius `rho`.
+inline Vec3 atRelativeRadius(Vec3 p, double rho) { return (rho / relativeRadius(p)) * p; }
+// Where the ray origin + t * direction (t > 0) reaches relative radius `rho`,
+// for an origin inside that shell.
+Vec3 shellPoint(Vec3 origin, Vec3 direction, double rho);
+
+// A polyline sampled from a fiber's smooth guide curve, with each segment's
+// unit tangent, its length and the arc length at its start.
+struct Guide {
+  std::vector<Vec3> points;
+  std::vector<Vec3> tangents;    // tangents[i] = unit (points[i+1] - points[i])
+  std::vector<double> arc;       // arc[i] = arc length at points[i]; arc.size() == points.size()
+  double length() const { return arc.empty() ? 0.0 : arc.back(); }
+};
+
+// Samples the centripetal Catmull-Rom spline through `controls` (at least
+// two points, consecutive points distinct) every `spacing` mm or less into
+// `guide`. The centripetal parameterisation (alpha = 1/2) never forms cusps
+// or self-intersections within a span, so unevenly spaced anatomical control
+// points still give a smooth curve.
+void buildGuide(const std::vector<Vec3>& controls, double spacing, Guide& guide);
+
+// Constants of the tracker, derived once from the options.
+struct TrackerParameters {
+  double step = 0.1;          // mm, every segment has exactly this length
+  double lookahead = 4.0;     // mm, pure-pursuit distance along the guide
+  double steer = 0.1;         // fraction of the way turned towards the target per step
+  double jitter_sigma = 0.0;  // radians, per-axis direction noise per step
+  double cos_max_turn = 1.0;  // cos and sin of the largest turn the tracker takes
+  double sin_max_turn = 0.0;
+};
+
+// Tracks from arc length `start_arc` of `guide` for at most `steps` steps,
+// appending the points (x, y, z floats) to `xyz`. Every step is exactly
+// params.step long measured between the stored float points (to float
+// precision), turns by at most the parameters' maximum turn, and the walk
+// stops before the first point that would leave the phantom's ellipsoid.
+// Returns the number of points appended: 0 when the start is outside.
+size_t trackAlongGuide(const Guide& guide, double start_arc, size_t steps, const TrackerParameters& params, Rng& rng,
+                       std::vector<float>& xyz);
+
+// Anatomy: the brain-like bundles and the U-fiber sites under the cortex.
+struct UFiberSite {
+  Vec3 centre;   // unit direction from the origin to the site
+  Vec3 tangent;  // unit, perpendicular to centre: the direction the U spans
+  double span_mm = 20;
+};
+// The fixed table of U-fiber sites (same for every seed: anatomy does not
+// change with the tracking seed).
+const std::vector<UFiberSite>& uFiberSites();
+
+// Draws the shape of one fiber of bundle `bundle` from `rng` and writes the
+// control points of its guide curve (cortex to cortex, or brainstem to
+// cortex), in a canonical order (the caller may reverse it). Every control
+// point lies inside the ellipsoid, at relative radius 0.99 or less.
+void fiberControls(PhantomBundle bundle, Rng& rng, std::vector<Vec3>& controls);
+
+// Probability that a fiber of `bundle` covers its whole guide rather than a
+// random part of it (tracking stops early in real data: low FOD amplitude,
+// crossing regions, seeds in the middle of a bundle).
+double fullSpanProbability(PhantomBundle bundle);
+
+}  // namespace fibscope::phantom_detail
