@@ -17,6 +17,7 @@ void addPhantomCommand(CLI::App& app) {
     std::string output;
     PhantomOptions phantom;
     bool force = false;
+    std::string bundles;
     WriterOptions writer;
   };
   auto opt = std::make_shared<Options>();
@@ -25,10 +26,12 @@ void addPhantomCommand(CLI::App& app) {
   cmd->add_option("--streamlines,-n", opt->phantom.streamlines, "Number of streamlines")
       ->capture_default_str()
       ->check(CLI::Range(uint64_t(1), uint64_t(1) << 40));
-  cmd->add_option("--step", opt->phantom.step_mm, "Step length in mm")->capture_default_str()->check(CLI::Range(1e-4, 10.0));
+  cmd->add_option("--step", opt->phantom.step_mm, "Step length in mm")->capture_default_str();
   cmd->add_option("--max-angle", opt->phantom.max_angle_deg, "Maximum turning angle between segments, degrees")
-      ->capture_default_str()
-      ->check(CLI::Range(0.01, 90.0));
+      ->capture_default_str();
+  cmd->add_option("--jitter", opt->phantom.jitter, "Tracker noise: 1 probabilistic-like, 0 smooth")->capture_default_str();
+  cmd->add_option("--bundles", opt->bundles,
+                  "Bundle mix, e.g. corpus_callosum=2,u_fibers=0 (others keep their default weight)");
   cmd->add_option("--seed", opt->phantom.seed, "Random seed")->capture_default_str();
   cmd->add_option("--min-length", opt->phantom.min_length_mm, "Minimum fiber length in mm")->capture_default_str();
   cmd->add_option("--max-length", opt->phantom.max_length_mm, "Maximum fiber length in mm")->capture_default_str();
@@ -40,8 +43,7 @@ void addPhantomCommand(CLI::App& app) {
   cmd->add_flag("--force,-f", opt->force, "Overwrite the output if it exists");
   cmd->callback([opt] {
     checkOverwrite(opt->output, opt->force);
-    if (opt->phantom.min_length_mm > opt->phantom.max_length_mm)
-      throw Error("--min-length must not exceed --max-length");
+    if (!opt->bundles.empty()) opt->phantom.bundle_weights = parsePhantomBundleMix(opt->bundles);
     auto reader = openPhantom(opt->phantom);
     WriterOptions wo = opt->writer;
     wo.overwrite = opt->force;
