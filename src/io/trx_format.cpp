@@ -92,6 +92,23 @@ size_t decodeIndicesAs(const uint8_t* src, size_t count, uint64_t* dst) {
   return count;
 }
 
+// Member names go into one-line messages: control bytes are shown as \xNN.
+std::string printable(std::string_view name) {
+  std::string out;
+  for (const char c : name) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u < 0x20 || u == 0x7f) {
+      const char* hex = "0123456789abcdef";
+      out += "\\x";
+      out += hex[u >> 4];
+      out += hex[u & 15];
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
 uint16_t le16(const uint8_t* p) { return loadUnaligned<uint16_t>(p, kSwap); }
 uint32_t le32(const uint8_t* p) { return loadUnaligned<uint32_t>(p, kSwap); }
 uint64_t le64(const uint8_t* p) { return loadUnaligned<uint64_t>(p, kSwap); }
@@ -264,6 +281,7 @@ Archive::Archive(const std::string& path) : path_(path) {
     listDirectory();
   } else {
     map_ = MappedFile(path);
+    map_.adviseSequential();  // members are read front to back (several at once: that is fine)
     file_bytes_ = map_.size();
     listZip();
     stripTopFolder();
@@ -286,11 +304,12 @@ void Archive::listDirectory() {
   for (; it != fs::recursive_directory_iterator(); it.increment(ec)) {
     if (ec) fail(path_, "cannot list directory: " + ec.message());
     const fs::directory_entry& entry = *it;
-    const std::string name = entry.path().lexically_relative(root).generic_string();
+    const std::string raw_name = entry.path().lexically_relative(root).generic_string();
+    const std::string name = printable(raw_name);
     std::error_code kind_ec;
     if (entry.is_directory(kind_ec)) continue;
-    if (!entry.is_regular_file(kind_ec)) {
-      notes_.push_back("ignored " + name + " (not a regular file)");
+    if (!entry.is_regular_file(kind_ec) || name != raw_name) {
+      notes_.push_back("ignored " + name + (name != raw_name ? " (control characters in its name)" : " (not a regular file)"));
       continue;
     }
     Member m;
@@ -374,7 +393,8 @@ void Archive::listZip() {
     const uint64_t entry_bytes = kCentralHeaderBytes + name_length + extra_length + comment_length;
     if (entry_bytes > end - p)
       failAt(path_, p, "zip central directory entry " + std::to_string(index) + " runs past the central directory");
-    const std::string name(reinterpret_cast<const char*>(d + p + kCentralHeaderBytes), name_length);
+    const std::string raw_name(reinterpret_cast<const char*>(d + p + kCentralHeaderBytes), name_length);
+    const std::string name = printable(raw_name);
 
     // The zip64 extra field holds, in this order, whichever of the sizes and
     // the local header offset are 0xffffffff in the fixed fields.
@@ -401,6 +421,10 @@ void Archive::listZip() {
     p += entry_bytes;
     if (start_disk != 0 && start_disk != 0xffff) fail(path_, "multi-disk zip archives are not supported");
     if (name.empty() || name.back() == '/') continue;  // folder entry
+    if (name != raw_name) {
+      notes_.push_back("ignored member " + name + " (control characters in its name)");
+      continue;
+    }
 
     // The local header repeats the name and has its own extra field; the
     // data follows it and must end before the central directory.
@@ -510,6 +534,7 @@ std::unique_ptr<MemberReader> Archive::open(const Member& member) {
   if (is_directory_) {
     reader->own_map_ = MappedFile(member.file_path);
     if (reader->own_map_.size() != member.size) reader->failMember("file changed size while being read");
+    reader->own_map_.adviseSequential();
     reader->base_ = reader->own_map_.data();
     reader->map_ = &reader->own_map_;
     reader->map_offset_ = 0;

@@ -146,11 +146,14 @@ void TrxReader::parseHeader() {
   if (values.size() != 16 || !std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); }))
     failMember("header.json", "VOXEL_TO_RASMM must be 4 lists of 4 finite numbers, found " + shortDump(affine));
 
+  // DIMENSIONS: 3 non-negative integers (uint16 in the spec; integral floats accepted).
   const nlohmann::json& dimensions = find("DIMENSIONS");
+  auto dimension = [](const nlohmann::json& v) -> int64_t {
+    const double d = v.is_number() ? v.get<double>() : -1.0;
+    return d >= 0 && d <= std::numeric_limits<int32_t>::max() && std::floor(d) == d ? static_cast<int64_t>(d) : -1;
+  };
   if (!dimensions.is_array() || dimensions.size() != 3 ||
-      !std::all_of(dimensions.begin(), dimensions.end(), [](const nlohmann::json& v) {
-        return v.is_number_unsigned() && v.get<uint64_t>() <= uint64_t(std::numeric_limits<int32_t>::max());
-      }))
+      !std::all_of(dimensions.begin(), dimensions.end(), [&](const nlohmann::json& v) { return dimension(v) >= 0; }))
     failMember("header.json", "DIMENSIONS must be a list of 3 non-negative integers, found " + shortDump(dimensions));
 
   Space& space = header_.space;
@@ -158,7 +161,7 @@ void TrxReader::parseHeader() {
   for (size_t i = 0; i < 16; ++i) space.voxel_to_rasmm[i] = static_cast<float>(values[i]);
   space.voxel_order.clear();
   for (size_t axis = 0; axis < 3; ++axis) {
-    space.dimensions[axis] = static_cast<int32_t>(dimensions[axis].get<uint64_t>());
+    space.dimensions[axis] = static_cast<int32_t>(dimension(dimensions[axis]));
     // Voxel size: length of the axis' column; orientation: the world axis it
     // points along most (as nibabel's aff2axcodes).
     double norm2 = 0;
@@ -407,17 +410,20 @@ bool TrxReader::read(Tractogram& chunk, size_t max_points) {
   auto follow = [](std::vector<DataArray>& arrays, const std::vector<DataArray>& declared) {
     bool same = arrays.size() == declared.size();
     for (size_t i = 0; same && i < arrays.size(); ++i)
-      same = arrays[i].name == declared[i].name && arrays[i].components == declared[i].components;
+      same = arrays[i].name == declared[i].name && arrays[i].components == declared[i].components &&
+             arrays[i].dtype == declared[i].dtype;
     if (!same) arrays = declared;
   };
   follow(chunk.per_streamline, header_.per_streamline);
   follow(chunk.per_point, header_.per_point);
   if (next_streamline_ >= nb_streamlines_) return false;
 
-  // Whole streamlines up to max_points points; at least one.
+  // Whole streamlines up to max_points points (and at most max_points
+  // streamlines, which matters only for runs of empty ones); at least one.
   const uint64_t first = next_streamline_;
   const uint64_t budget = std::clamp<uint64_t>(max_points, 1, kMaxCount);
-  const auto end = std::upper_bound(offsets_.begin() + static_cast<ptrdiff_t>(first) + 1, offsets_.end(),
+  const auto limit = offsets_.begin() + static_cast<ptrdiff_t>(std::min(nb_streamlines_, first + budget)) + 1;
+  const auto end = std::upper_bound(offsets_.begin() + static_cast<ptrdiff_t>(first) + 1, limit,
                                     offsets_[first] + budget);
   const uint64_t last = std::max<uint64_t>(first + 1, static_cast<uint64_t>(end - offsets_.begin()) - 1);
   const uint64_t points = offsets_[last] - offsets_[first];
