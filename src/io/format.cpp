@@ -58,7 +58,16 @@ std::unique_ptr<TractogramWriter> createTractogramWriter(const std::string& path
 
 void writeTractogram(const std::string& path, const Tractogram& tractogram, const TractogramHeader& like,
                      const WriterOptions& options, std::vector<std::string>* warnings) {
-  auto writer = createTractogramWriter(path, like, options);
+  // The arrays come from the tractogram itself when `like` names none.
+  TractogramHeader header = like;
+  auto describe = [](const std::vector<DataArray>& arrays) {
+    std::vector<DataArray> names;
+    for (const auto& a : arrays) names.push_back({a.name, a.components, a.dtype, {}});
+    return names;
+  };
+  if (header.per_streamline.empty()) header.per_streamline = describe(tractogram.per_streamline);
+  if (header.per_point.empty()) header.per_point = describe(tractogram.per_point);
+  auto writer = createTractogramWriter(path, header, options);
   writer->write(tractogram);
   writer->finish();
   if (warnings) warnings->insert(warnings->end(), writer->warnings().begin(), writer->warnings().end());

@@ -45,7 +45,8 @@ class TractogramWriter {
 std::unique_ptr<TractogramWriter> createTractogramWriter(const std::string& path, const TractogramHeader& like,
                                                          const WriterOptions& options = {});
 
-// Writes a whole tractogram (tests, small files).
+// Writes a whole tractogram (tests, small files). Data arrays are described
+// by `like`, or by the tractogram itself when `like` names none.
 void writeTractogram(const std::string& path, const Tractogram& tractogram, const TractogramHeader& like,
                      const WriterOptions& options = {}, std::vector<std::string>* warnings = nullptr);
 

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstring>
+#include <limits>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -59,7 +61,9 @@ TEST(Cli, failedConvertLeavesNoOutputBehind) {
   const Tractogram t = test::smallTractogram(3);
   writeTractogram(dir.file("in.tck"), t, TractogramHeader{});
   std::string bytes = test::readBytes(dir.file("in.tck"));
-  const size_t data = bytes.find("END\n") + 4;
+  const size_t file_key = bytes.find("file: . ");
+  ASSERT_NE(file_key, std::string::npos);
+  const size_t data = std::stoul(bytes.substr(file_key + 8));
   const size_t second = data + 12 * (t.pointsIn(0) + 1) + 4;  // y of the first point of streamline 1
   const float nan = std::numeric_limits<float>::quiet_NaN();
   std::memcpy(&bytes[second], &nan, 4);
