@@ -43,6 +43,29 @@ std::string shortDump(const nlohmann::json& value) {
   return text;
 }
 
+// Deepest nesting of JSON arrays and objects in `text` (brackets inside
+// strings do not count). Checked before parsing: serialising a value back
+// (dump()) recurses once per level.
+size_t jsonNesting(std::string_view text) {
+  size_t depth = 0;
+  size_t deepest = 0;
+  bool in_string = false;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (in_string) {
+      if (c == '\\') ++i;
+      else if (c == '"') in_string = false;
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      deepest = std::max(deepest, ++depth);
+    } else if ((c == ']' || c == '}') && depth > 0) {
+      --depth;
+    }
+  }
+  return deepest;
+}
+
 std::vector<std::string_view> splitPath(std::string_view name) {
   std::vector<std::string_view> parts;
   size_t start = 0;
@@ -106,6 +129,9 @@ void TrxReader::parseHeader() {
   const std::string text = archive_.readWhole(*member, kMaxHeaderBytes);
   fixed_bytes_read_ += member->stored_size;
 
+  constexpr size_t kMaxNesting = 64;
+  if (jsonNesting(text) > kMaxNesting)
+    failMember("header.json", "JSON nests deeper than " + std::to_string(kMaxNesting) + " levels");
   nlohmann::json header;
   try {
     header = nlohmann::json::parse(text);

@@ -511,6 +511,34 @@ TEST(TrxRoundTrip, keepsDtypesGroupsDataPerGroupAndHeaderKeys) {
   EXPECT_EQ(ref["header"]["DIMENSIONS"], original["header"]["DIMENSIONS"]);
 }
 
+TEST(TrxRoundTrip, largeArraysSurviveStoredAndDeflatedMembers) {
+  REQUIRE_NUMPY();
+  // 360k points: 1.08 M coordinates, more than one decode step of 2^20
+  // values in one chunk; then again in chunks of 123457 points.
+  Tractogram t;
+  t.per_point.push_back({"fa", 1, "float32", {}});
+  std::vector<float> xyz(300);
+  for (int s = 0; s < 3600; ++s) {
+    for (int i = 0; i < 300; ++i) xyz[i] = static_cast<float>(s) * 0.01f + static_cast<float>(i) * 0.5f;
+    t.addStreamline(xyz.data(), 100);
+    for (int i = 0; i < 100; ++i) t.per_point[0].values.push_back(static_cast<float>(s * 100 + i));
+  }
+  test::TempDir dir;
+  WriterOptions options;
+  options.trx_zip = false;
+  writeChunked(dir.file("big_dir.trx"), t, likeFor(t), options, 1500);
+  runReference("zip " + dir.file("big_dir.trx") + " " + dir.file("big_deflated.trx") + " --method deflated");
+  writeChunked(dir.file("big_stored.trx"), t, likeFor(t), {}, 3600);
+  for (const auto& [name, max_points] : std::vector<std::pair<std::string, size_t>>{
+           {"big_dir.trx", size_t(1) << 20}, {"big_deflated.trx", size_t(1) << 20},
+           {"big_stored.trx", size_t(1) << 20}, {"big_stored.trx", 123457}}) {
+    const Tractogram back = readChunked(dir.file(name), max_points);
+    EXPECT_EQ(back.offsets, t.offsets) << name;
+    EXPECT_EQ(back.positions, t.positions) << name;
+    EXPECT_EQ(back.per_point[0].values, t.per_point[0].values) << name;
+  }
+}
+
 TEST(TrxWriter, refusesToOverwriteUnlessAsked) {
   test::TempDir dir;
   const Tractogram t = test::smallTractogram(5);
@@ -650,6 +678,8 @@ TEST(TrxMalformed, headerProblemsAreReported) {
   expectOneLineError(readError(trx), trx, "invalid JSON");
   test::writeBytes(trx + "/header.json", "");
   expectOneLineError(readError(trx), trx, "invalid JSON");
+  test::writeBytes(trx + "/header.json", "{\"a\": " + std::string(100000, '[') + std::string(100000, ']') + "}");
+  expectOneLineError(readError(trx), trx, "nests deeper");
 }
 
 TEST(TrxMalformed, badOffsetsAreReported) {
