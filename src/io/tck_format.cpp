@@ -8,9 +8,17 @@
 #include <cstring>
 #include <limits>
 
+#include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cerrno>
+
 #include "core/error.h"
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace fibscope {
 namespace {
@@ -58,19 +66,27 @@ std::optional<std::string> singleValue(const std::string& path, const TckHeaderI
 // so NaN/Inf are found without converting anything.
 template <typename Word>
 size_t findNonFiniteWords(const uint8_t* p, size_t n, Word mask) {
-  // Fixed blocks without an early exit inside let the compiler vectorise the
-  // test; the exact index is then found in the one block that has a hit.
-  constexpr size_t kBlock = 64 / sizeof(Word);
   size_t i = 0;
-  for (; i + kBlock <= n; i += kBlock) {
-    bool hit = false;
-    for (size_t k = 0; k < kBlock; ++k) {
-      Word w;
-      std::memcpy(&w, p + (i + k) * sizeof(Word), sizeof(Word));
-      hit |= (w & mask) == mask;
+#if defined(__SSE2__)
+  // 64 bytes per step: AND with the exponent mask and compare 32-bit lanes;
+  // a 64-bit sample matches when both of its lanes do (its other lane of the
+  // mask is zero, so it always compares equal). The exact index is found by
+  // the scalar loop below, which starts in the step that has a hit.
+  const __m128i m = sizeof(Word) == 4 ? _mm_set1_epi32(static_cast<int>(mask))
+                                      : _mm_set1_epi64x(static_cast<long long>(mask));
+  constexpr size_t kStep = 64 / sizeof(Word);
+  for (; i + kStep <= n; i += kStep) {
+    const uint8_t* q = p + i * sizeof(Word);
+    __m128i any = _mm_setzero_si128();
+    for (int k = 0; k < 4; ++k) {
+      const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(q + 16 * k));
+      __m128i eq = _mm_cmpeq_epi32(_mm_and_si128(v, m), m);
+      if constexpr (sizeof(Word) == 8) eq = _mm_and_si128(eq, _mm_shuffle_epi32(eq, _MM_SHUFFLE(2, 3, 0, 1)));
+      any = _mm_or_si128(any, eq);
     }
-    if (hit) break;
+    if (_mm_movemask_epi8(any) != 0) break;
   }
+#endif
   for (; i < n; ++i) {
     Word w;
     std::memcpy(&w, p + i * sizeof(Word), sizeof(Word));
@@ -240,6 +256,19 @@ void decodeSamples(const uint8_t* p, size_t n, const TckDataType& type, float* o
   }
 }
 
+void appendSamples(const uint8_t* p, size_t n, const TckDataType& type, std::vector<float>& out,
+                   const std::string& path, uint64_t file_offset) {
+  if (type.bytes == 4 && !type.needsSwap() && reinterpret_cast<uintptr_t>(p) % alignof(float) == 0) {
+    // One bulk copy, without zero-filling the destination first.
+    const auto* f = reinterpret_cast<const float*>(p);
+    out.insert(out.end(), f, f + n);
+    return;
+  }
+  const size_t old = out.size();
+  out.resize(old + n);
+  decodeSamples(p, n, type, out.data() + old, path, file_offset);
+}
+
 void encodeSamples(const float* values, size_t n, const TckDataType& type, std::vector<uint8_t>& out) {
   const size_t old = out.size();
   out.resize(old + n * type.bytes);
@@ -260,13 +289,44 @@ void encodeRepeated(float value, size_t n, const TckDataType& type, std::vector<
   for (size_t i = 0; i < n; ++i) encodeSamples(&value, 1, type, out);
 }
 
-uint64_t releaseConsumedPages(const MappedFile& file, uint64_t released, uint64_t consumed) {
-  constexpr uint64_t kReleaseBytes = uint64_t(64) << 20;
-  if (consumed < released || consumed - released < kReleaseBytes) return released;
-  static const uint64_t page = static_cast<uint64_t>(::sysconf(_SC_PAGESIZE));
-  const uint64_t end = consumed / page * page;
-  file.release(static_cast<size_t>(released), static_cast<size_t>(end));
-  return end;
+TrackDataStream::TrackDataStream(const std::string& path, uint64_t begin, uint64_t end)
+    : path_(path), next_(begin), end_(end) {
+  fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd_ < 0) failErrno(path, "cannot open");
+  ::posix_fadvise(fd_, 0, 0, POSIX_FADV_SEQUENTIAL);
+  // 1 MiB: big enough that syscalls cost nothing, small enough to stay in L2.
+  // Small files get a buffer of their size (then ASan sees any overread).
+  const uint64_t bytes = std::clamp<uint64_t>(end > begin ? end - begin : 0, 64, uint64_t(1) << 20);
+  buffer_.resize(static_cast<size_t>((bytes + sizeof(float) - 1) / sizeof(float)));
+  capacity_ = buffer_.size() * sizeof(float);
+}
+
+TrackDataStream::~TrackDataStream() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+size_t TrackDataStream::fill(size_t n) {
+  if (available() >= n || next_ >= end_) return available();
+  // Keep the unread tail, moved to the front (less than a streamline's worth).
+  std::memmove(bytes(), bytes() + head_, available());
+  tail_ -= head_;
+  head_ = 0;
+  while (tail_ < capacity_ && next_ < end_) {
+    const size_t want = static_cast<size_t>(std::min<uint64_t>(capacity_ - tail_, end_ - next_));
+    const ssize_t got = ::pread(fd_, bytes() + tail_, want, static_cast<off_t>(next_));
+    if (got < 0) {
+      if (errno == EINTR) continue;
+      failErrno(path_, "read failed at byte " + std::to_string(next_));
+    }
+    if (got == 0) {
+      // The file shrank since it was opened: treat what is there as all.
+      end_ = next_;
+      break;
+    }
+    tail_ += static_cast<size_t>(got);
+    next_ += static_cast<uint64_t>(got);
+  }
+  return available();
 }
 
 bool isTckWriterOwnedKey(std::string_view key) {
@@ -308,11 +368,20 @@ TckHeaderText makeTckHeader(std::string_view magic, const std::vector<std::pair<
   h.append("count: ");
   out.count_offset = h.size();
   h.append(formatTckCount(0)).append("\n");
-  // The offset counts its own digits: grow the digit count until stable.
-  const size_t base = h.size() + std::strlen("file: . ") + std::strlen("\nEND\n");
-  size_t digits = 1;
-  while (std::to_string(base + digits).size() != digits) ++digits;
-  h.append("file: . ").append(std::to_string(base + digits)).append("\nEND\n");
+  // The offset counts its own digits. The data starts on a 16-byte boundary
+  // (zero padding after END, as MRtrix leaves): samples are then aligned in
+  // the map and native float32 is copied out in bulk.
+  const size_t end = h.size() + std::strlen("file: . ") + std::strlen("\nEND\n");
+  size_t offset = end + 1;
+  while (true) {
+    const size_t header_end = end + std::to_string(offset).size();
+    const size_t aligned = (header_end + 15) / 16 * 16;
+    if (aligned == offset) break;
+    offset = aligned;
+  }
+  const std::string digits = std::to_string(offset);
+  h.append("file: . ").append(digits).append("\nEND\n");
+  h.append(offset - h.size(), '\0');
   return out;
 }
 

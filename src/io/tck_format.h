@@ -72,6 +72,11 @@ size_t findNonFinite(const uint8_t* p, size_t n, const TckDataType& type);
 enum class SampleKind { kFinite, kNaN, kInf };
 SampleKind classifySample(const uint8_t* p, const TckDataType& type);
 
+// Appends `n` samples at `p` to `out` as float (one bulk copy for native
+// float32); same checks as decodeSamples.
+void appendSamples(const uint8_t* p, size_t n, const TckDataType& type, std::vector<float>& out,
+                   const std::string& path, uint64_t file_offset);
+
 // Converts `n` samples at `p` to float into `out`. Float64 samples beyond the
 // float range throw Error naming `path` and the byte offset (`file_offset` is
 // the offset of `p` in the file). Samples must be finite (checked by caller).
@@ -85,7 +90,7 @@ void encodeRepeated(float value, size_t n, const TckDataType& type, std::vector<
 
 // The header a writer puts in front of its samples.
 struct TckHeaderText {
-  std::string text;              // ends with "END\n"; text.size() == data offset
+  std::string text;              // "END\n" then zero padding; text.size() == data offset, a multiple of 16
   uint64_t count_offset = 0;     // where the count digits start
   static constexpr size_t kCountDigits = 20;  // enough for any uint64
 };
@@ -103,11 +108,49 @@ TckHeaderText makeTckHeader(std::string_view magic, const std::vector<std::pair<
 // The fixed-width count digits, e.g. "00000000000000001000".
 std::string formatTckCount(uint64_t count);
 
-// Hands mapped pages in [released, consumed) back to the kernel once at
-// least 64 MiB have been consumed since the last time, so that reading a
-// 100 GB file keeps resident memory bounded. Returns the new `released`
-// (page aligned, so no page is skipped between calls).
-uint64_t releaseConsumedPages(const MappedFile& file, uint64_t released, uint64_t consumed);
+// The samples of a track file, read front to back through one buffer.
+//
+// The data is copied out with pread() rather than parsed in the map: on
+// virtual machines (nested paging) touching mapped page-cache pages costs a
+// TLB miss every 4 KiB and reads ~1 GB/s, while the kernel copies the same
+// pages at ~8 GB/s through its huge-page direct map; the copy lands in a
+// buffer that stays in L2 for the scan. Resident memory is the buffer alone,
+// whatever the file size. Buffered bytes always start at a multiple of the
+// sample size from the data offset, so samples are aligned in memory.
+class TrackDataStream {
+ public:
+  // Opens `path` to read its bytes [begin, end). Throws Error if it cannot.
+  TrackDataStream(const std::string& path, uint64_t begin, uint64_t end);
+  ~TrackDataStream();
+  TrackDataStream(const TrackDataStream&) = delete;
+  TrackDataStream& operator=(const TrackDataStream&) = delete;
+
+  // Buffered bytes: those of the file at [position(), position() + available()).
+  const uint8_t* data() const { return bytes() + head_; }
+  size_t available() const { return tail_ - head_; }
+  uint64_t position() const { return next_ - (tail_ - head_); }
+  uint64_t end() const { return end_; }
+  // Forgets the first `n` buffered bytes (n <= available()).
+  void consume(size_t n) { head_ += n; }
+  // Buffers at least `n` bytes (n <= 64, a triplet at most), fewer only at
+  // the end of the data. Reads ahead as much as fits. Returns available().
+  size_t fill(size_t n);
+
+ private:
+  uint8_t* bytes() { return reinterpret_cast<uint8_t*>(buffer_.data()); }
+  const uint8_t* bytes() const { return reinterpret_cast<const uint8_t*>(buffer_.data()); }
+
+  std::string path_;
+  int fd_ = -1;
+  // Float storage, so aligned native float32 samples are read as the floats
+  // they are; everything else goes through bytes.
+  std::vector<float> buffer_;
+  size_t head_ = 0;  // bytes
+  size_t tail_ = 0;
+  size_t capacity_ = 0;
+  uint64_t next_ = 0;  // file offset of buffer_[tail_]
+  uint64_t end_ = 0;
+};
 
 // `text` with control bytes replaced and cut to `max_chars`, for quoting file
 // contents inside one-line messages.

@@ -1,11 +1,11 @@
 // MRtrix3 .tck reader (format in io/tck_format.h), with optional .tsf files
 // attached as per-point arrays.
 //
-// The file is mapped and parsed in place. Each streamline is one scan for
+// The header is parsed from a map of the file; the samples stream through
+// one buffer (TrackDataStream). Each streamline is one vectorised scan for
 // the next non-finite sample (its NaN separator) followed by one bulk copy
 // of the points before it into the chunk, so the cost per point is a few
-// instructions and the file is read at memory speed. Pages behind the
-// reading position are handed back to the kernel as reading goes on.
+// instructions and resident memory stays bounded for any file size.
 //
 // Recoverable damage (tracking interrupted: wrong or missing count, no
 // terminator, a partial last streamline) is read as far as it is whole and
@@ -38,21 +38,21 @@ class TckReader final : public TractogramReader {
   TckReader(const std::string& path, const std::vector<std::string>& tsf_paths);
 
   bool read(Tractogram& chunk, size_t max_points) override;
-  uint64_t bytesRead() const override { return pos_; }
+  uint64_t bytesRead() const override { return at_end_ ? header_.file_bytes : data_->position(); }
 
  private:
-  // Reads the streamline at pos_ into `chunk`; false once the data ended.
+  // Reads the next streamline into `chunk`; false once the data ended.
   bool readStreamline(Tractogram& chunk);
+  // Makes a whole triplet available at the front; false at the end of data.
+  bool fillTriplet() { return data_->fill(triplet_bytes_) >= triplet_bytes_; }
   // Ends reading: the warning for a truncated file, then the count and tsf checks.
   void endOfData(bool truncated);
   void prepareChunk(Tractogram& chunk) const;
   void warnFor(const std::string& path, const std::string& message) { warnings_.push_back(path + ": " + message); }
 
-  MappedFile file_;
+  std::unique_ptr<TrackDataStream> data_;
   TckDataType type_;
-  uint64_t triplet_bytes_ = 12;
-  uint64_t pos_ = 0;         // next byte to parse
-  uint64_t released_ = 0;    // pages before this were handed back
+  size_t triplet_bytes_ = 12;
   uint64_t streamlines_ = 0; // read so far
   bool has_count_line_ = false;
   int64_t header_count_ = -1;
@@ -60,27 +60,32 @@ class TckReader final : public TractogramReader {
   std::vector<std::unique_ptr<TsfReader>> tsf_;
 };
 
-TckReader::TckReader(const std::string& path, const std::vector<std::string>& tsf_paths) : file_(path) {
-  const TckHeaderInfo info = parseTckHeader(file_, kTckMagic);
+TckReader::TckReader(const std::string& path, const std::vector<std::string>& tsf_paths) {
+  TckHeaderInfo info;
+  {
+    const MappedFile file(path);
+    info = parseTckHeader(file, kTckMagic);
+    header_.file_bytes = file.size();
+  }
   header_.path = path;
   header_.format = "tck";
-  header_.file_bytes = file_.size();
   header_.properties = info.properties;
   for (const auto& w : info.warnings) warn(w);
   type_ = info.datatype;
   triplet_bytes_ = 3 * type_.bytes;
-  pos_ = info.data_offset;
+  data_ = std::make_unique<TrackDataStream>(path, info.data_offset, header_.file_bytes);
   has_count_line_ = std::any_of(info.properties.begin(), info.properties.end(),
                                 [](const auto& kv) { return kv.first == "count"; });
   header_count_ = info.count;
   if (header_count_ >= 0) {
     // Every streamline takes at least its separator triplet.
-    const uint64_t most = (file_.size() - pos_) / triplet_bytes_;
+    const uint64_t data_bytes = header_.file_bytes - info.data_offset;
+    const uint64_t most = data_bytes / triplet_bytes_;
     if (static_cast<uint64_t>(header_count_) <= most) {
       header_.declared_streamlines = header_count_;
     } else {
-      warn("header count " + std::to_string(header_count_) + " is impossible: " +
-           std::to_string(file_.size() - pos_) + " bytes of data hold at most " + std::to_string(most) +
+      warn("header count " + std::to_string(header_count_) + " is impossible: " + std::to_string(data_bytes) +
+           " bytes of data hold at most " + std::to_string(most) +
            " streamlines");
     }
   }
@@ -102,7 +107,6 @@ TckReader::TckReader(const std::string& path, const std::vector<std::string>& ts
     header_.per_point.push_back({name, 1, tsf->info().datatype.arrayDtype(), {}});
     tsf_.push_back(std::move(tsf));
   }
-  file_.adviseSequential();
 }
 
 void TckReader::prepareChunk(Tractogram& chunk) const {
@@ -118,89 +122,86 @@ bool TckReader::read(Tractogram& chunk, size_t max_points) {
   if (at_end_) return false;
   max_points = std::max<size_t>(max_points, 1);
   // Bounded by what the file can still hold, so a lying file cannot make us allocate.
-  const uint64_t left = (file_.size() - pos_) / triplet_bytes_;
+  const uint64_t left = (data_->end() - data_->position()) / triplet_bytes_;
   chunk.positions.reserve(3 * static_cast<size_t>(std::min<uint64_t>(left, max_points)));
   // A run of zero-length streamlines adds no points, so cap streamlines too.
   while (chunk.pointCount() < max_points && chunk.streamlineCount() < max_points) {
     if (!readStreamline(chunk)) break;
   }
-  released_ = releaseConsumedPages(file_, released_, pos_);
-  for (auto& tsf : tsf_) tsf->releaseConsumed();
   return chunk.streamlineCount() > 0;
 }
 
 bool TckReader::readStreamline(Tractogram& chunk) {
-  const uint8_t* base = file_.data();
-  const uint64_t end = file_.size();
-  const uint64_t start = pos_;
   const size_t s = type_.bytes;
-  const size_t available = static_cast<size_t>((end - start) / s);
-  // The separator is the first non-finite sample; everything before it must
-  // be whole finite points.
-  const size_t hit = findNonFinite(base + start, available, type_);
-  const uint64_t points = hit / 3;
-  const uint64_t triplet = start + points * triplet_bytes_;
-
-  const std::string where = "streamline " + std::to_string(streamlines_) + " point " + std::to_string(points);
-  // Names what each coordinate of the triplet holds, for error messages.
-  auto describe = [&] {
-    std::string d = "(";
-    for (size_t c = 0; c < 3; ++c) {
-      const uint64_t at = triplet + c * s;
-      d += c ? ", " : "";
-      d += at + s <= end ? kindName(classifySample(base + at, type_)) : "missing";
+  const size_t first_point = chunk.positions.size() / 3;
+  uint64_t points = 0;  // of this streamline, already appended to the chunk
+  // Points stream in buffer by buffer until the first non-finite sample.
+  while (true) {
+    if (!fillTriplet()) {
+      // Tracking was interrupted: the last streamline has no separator (or
+      // only part of one) and the Inf terminator never came.
+      chunk.positions.resize(3 * first_point);
+      const uint64_t end = data_->end();
+      if (points == 0 && data_->available() == 0)
+        warn("no terminator: file truncated at byte " + std::to_string(end) + " after " +
+             std::to_string(streamlines_) + " complete streamlines");
+      else
+        warn("no terminator: file truncated at byte " + std::to_string(end) + ", last partial streamline of " +
+             std::to_string(points) + " points dropped");
+      endOfData(true);
+      return false;
     }
-    return d + ")";
-  };
-  const std::string kMixed = ": NaN or Inf in only some coordinates (a separator is three NaNs, the terminator three Infs)";
-  // A number followed by NaN/Inf in the same triplet never comes from a
-  // valid file cut short.
-  if (hit < available && hit % 3 != 0) failAt(header_.path, triplet, where + " is " + describe() + kMixed);
-
-  if (hit == available || triplet + triplet_bytes_ > end) {
-    // Tracking was interrupted: the last streamline has no separator (or
-    // only part of one) and the Inf terminator never came.
-    const uint64_t whole = (end - start) / triplet_bytes_;
-    if (end == start)
-      warn("no terminator: file truncated at byte " + std::to_string(end) + " after " + std::to_string(streamlines_) +
-           " complete streamlines");
-    else
-      warn("no terminator: file truncated at byte " + std::to_string(end) + ", last partial streamline of " +
-           std::to_string(std::min<uint64_t>(whole, points)) + " points dropped");
-    endOfData(true);
-    return false;
+    const size_t samples = data_->available() / s;
+    const size_t hit = findNonFinite(data_->data(), samples, type_);
+    const size_t whole = (hit == samples ? samples : hit) / 3;
+    appendSamples(data_->data(), 3 * whole, type_, chunk.positions, header_.path, data_->position());
+    points += whole;
+    data_->consume(whole * triplet_bytes_);
+    if (hit == samples) continue;
+    if (hit % 3 == 0 && !fillTriplet()) continue;  // a separator cut short: reported above
+    break;
   }
-  const SampleKind kinds[3] = {classifySample(base + triplet, type_), classifySample(base + triplet + s, type_),
-                               classifySample(base + triplet + 2 * s, type_)};
-  if (kinds[0] != kinds[1] || kinds[1] != kinds[2]) failAt(header_.path, triplet, where + " is " + describe() + kMixed);
+
+  // The front triplet holds the first non-finite sample.
+  const uint64_t triplet = data_->position();
+  const SampleKind kinds[3] = {
+      classifySample(data_->data(), type_),
+      data_->available() >= 2 * s ? classifySample(data_->data() + s, type_) : SampleKind::kFinite,
+      data_->available() >= 3 * s ? classifySample(data_->data() + 2 * s, type_) : SampleKind::kFinite};
+  if (kinds[0] == SampleKind::kFinite || kinds[0] != kinds[1] || kinds[1] != kinds[2]) {
+    // A number next to NaN/Inf in one triplet never comes from a valid file cut short.
+    std::string d;
+    for (size_t c = 0; c < 3; ++c)
+      d += std::string(c ? ", " : "") + (data_->available() >= (c + 1) * s ? kindName(kinds[c]) : "missing");
+    failAt(header_.path, triplet,
+           "streamline " + std::to_string(streamlines_) + " point " + std::to_string(points) + " is (" + d +
+               "): NaN or Inf in only some coordinates (a separator is three NaNs, the terminator three Infs)");
+  }
+  data_->consume(triplet_bytes_);
 
   if (kinds[0] == SampleKind::kInf) {
+    chunk.positions.resize(3 * first_point);
     if (points > 0)
       warn("streamline " + std::to_string(streamlines_) + " (" + std::to_string(points) +
            " points) has no NaN separator before the Inf terminator at byte " + std::to_string(triplet) +
            "; dropped");
     const uint64_t after = triplet + triplet_bytes_;
-    if (after < end)
-      warn(std::to_string(end - after) + " bytes after the Inf terminator at byte " + std::to_string(triplet) +
-           " ignored");
+    if (after < data_->end())
+      warn(std::to_string(data_->end() - after) + " bytes after the Inf terminator at byte " +
+           std::to_string(triplet) + " ignored");
     endOfData(false);
     return false;
   }
 
   // A NaN triplet: the streamline is complete (it may have zero points).
-  const size_t old = chunk.positions.size();
-  chunk.positions.resize(old + 3 * points);
-  decodeSamples(base + start, 3 * points, type_, chunk.positions.data() + old, header_.path, start);
   chunk.offsets.push_back(chunk.offsets.back() + points);
   for (size_t k = 0; k < tsf_.size(); ++k) tsf_[k]->readStreamline(streamlines_, points, chunk.per_point[k].values);
   ++streamlines_;
-  pos_ = triplet + triplet_bytes_;
   return true;
 }
 
 void TckReader::endOfData(bool truncated) {
   at_end_ = true;
-  pos_ = file_.size();
   const std::string holds = " the file holds " + std::to_string(streamlines_) + " streamlines";
   if (!has_count_line_)
     warn("header has no count;" + holds);

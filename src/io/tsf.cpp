@@ -17,10 +17,14 @@ std::string indexText(uint64_t index) { return "streamline " + std::to_string(in
 
 }  // namespace
 
-TsfReader::TsfReader(const std::string& path) : file_(path) {
-  info_ = parseTckHeader(file_, kTsfMagic);
-  pos_ = info_.data_offset;
-  file_.adviseSequential();
+TsfReader::TsfReader(const std::string& path) : path_(path) {
+  uint64_t file_bytes = 0;
+  {
+    const MappedFile file(path);
+    info_ = parseTckHeader(file, kTsfMagic);
+    file_bytes = file.size();
+  }
+  data_ = std::make_unique<TrackDataStream>(path, info_.data_offset, file_bytes);
 }
 
 std::string TsfReader::arrayName() const {
@@ -33,42 +37,45 @@ std::string TsfReader::arrayName() const {
 void TsfReader::readStreamline(uint64_t index, size_t points, std::vector<float>& values) {
   const TckDataType& type = info_.datatype;
   const size_t s = type.bytes;
-  const uint64_t available = (file_.size() - pos_) / s;
-  // The streamline's values and its separator, as far as the file has them.
-  const size_t wanted = points + 1;
-  const size_t scanned = static_cast<size_t>(std::min<uint64_t>(available, wanted));
-  const uint8_t* p = file_.data() + pos_;
-  const size_t j = findNonFinite(p, scanned, type);
   const std::string tck_side = " (the tractogram's streamline has " + std::to_string(points) + " points)";
-  if (j == scanned) {  // no NaN or Inf among the samples the file has
-    if (scanned < wanted)
-      failAt(path(), file_.size(), "file truncated inside " + indexText(index) + " after " +
-                                       std::to_string(scanned) + " values" + tck_side);
-    failAt(path(), pos_ + points * s, indexText(index) + " has more values than points" + tck_side);
+  size_t got = 0;  // values of this streamline appended so far
+  // The values then their NaN separator, buffer by buffer.
+  while (true) {
+    if (data_->fill(s) < s)
+      failAt(path(), data_->end(), "file truncated inside " + indexText(index) + " after " + std::to_string(got) +
+                                       " values" + tck_side);
+    const size_t wanted = points - got + 1;
+    const size_t scanned = std::min(data_->available() / s, wanted);
+    const size_t hit = findNonFinite(data_->data(), scanned, type);
+    const size_t finite = std::min(hit, points - got);
+    appendSamples(data_->data(), finite, type, values, path(), data_->position());
+    got += finite;
+    data_->consume(finite * s);
+    if (hit == scanned && scanned < wanted) continue;  // more values in the next buffer
+    break;
   }
-  if (j < points) {
-    if (classifySample(p + j * s, type) == SampleKind::kInf)
-      failAt(path(), pos_ + j * s,
+  // The front sample should be the separator.
+  const SampleKind kind = classifySample(data_->data(), type);
+  if (kind == SampleKind::kFinite)
+    failAt(path(), data_->position(), indexText(index) + " has more values than points" + tck_side);
+  if (got < points) {
+    if (kind == SampleKind::kInf)
+      failAt(path(), data_->position(),
              "the file ends after " + std::to_string(index) + " streamlines, but the tractogram has more (" +
                  indexText(index) + " has " + std::to_string(points) + " points)");
-    failAt(path(), pos_ + j * s, indexText(index) + " has " + std::to_string(j) + " values" + tck_side);
+    failAt(path(), data_->position(), indexText(index) + " has " + std::to_string(got) + " values" + tck_side);
   }
-  if (classifySample(p + points * s, type) != SampleKind::kNaN)
-    failAt(path(), pos_ + points * s,
+  if (kind == SampleKind::kInf)
+    failAt(path(), data_->position(),
            indexText(index) + " is followed by the Inf terminator instead of a NaN separator" + tck_side);
-  const size_t old = values.size();
-  values.resize(old + points);
-  decodeSamples(p, points, type, values.data() + old, path(), pos_);
-  pos_ += wanted * s;
+  data_->consume(s);
 }
 
-TsfReader::End TsfReader::end() const {
-  if (file_.size() - pos_ < info_.datatype.bytes) return End::kUnterminated;
-  return classifySample(file_.data() + pos_, info_.datatype) == SampleKind::kInf ? End::kTerminated
-                                                                                 : End::kMoreStreamlines;
+TsfReader::End TsfReader::end() {
+  if (data_->fill(info_.datatype.bytes) < info_.datatype.bytes) return End::kUnterminated;
+  return classifySample(data_->data(), info_.datatype) == SampleKind::kInf ? End::kTerminated
+                                                                           : End::kMoreStreamlines;
 }
-
-void TsfReader::releaseConsumed() { released_ = releaseConsumedPages(file_, released_, pos_); }
 
 size_t firstNonFinite(const float* values, size_t n) {
   for (size_t i = 0; i < n; ++i)

@@ -34,7 +34,7 @@ class TsfReader {
   // Maps `path` and parses its header (throws Error like the .tck reader).
   explicit TsfReader(const std::string& path);
 
-  const std::string& path() const { return file_.path(); }
+  const std::string& path() const { return path_; }
   const TckHeaderInfo& info() const { return info_; }
   // The per-point array name this file gives: its file name without ".tsf".
   std::string arrayName() const;
@@ -46,18 +46,15 @@ class TsfReader {
   enum class End { kTerminated, kUnterminated, kMoreStreamlines };
   // What follows the streamlines read so far: the Inf terminator, nothing
   // (a truncated file), or more streamlines than the tractogram has.
-  End end() const;
+  End end();
 
   // Bytes consumed so far (the position of the next sample).
-  uint64_t bytesRead() const { return pos_; }
-  // Drops mapped pages already consumed (bounded resident memory).
-  void releaseConsumed();
+  uint64_t bytesRead() const { return data_->position(); }
 
  private:
-  MappedFile file_;
+  std::string path_;
   TckHeaderInfo info_;
-  uint64_t pos_ = 0;
-  uint64_t released_ = 0;
+  std::unique_ptr<TrackDataStream> data_;
 };
 
 // Streams one value per point to a .tsf under a temporary name; finish()

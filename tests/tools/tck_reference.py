@@ -4,8 +4,8 @@
   tck_reference.py write OUT.tck SEED COUNT
       writes COUNT random streamlines (deterministic for SEED) with nibabel's
       TckFile, with an extra header key, and prints them as JSON.
-  tck_reference.py read IN.tck
-      loads IN.tck with nibabel and prints what it holds as JSON.
+  tck_reference.py read IN.tck [IN2.tck ...]
+      loads each file with nibabel and prints what it holds, one JSON line each.
 
 JSON: {"count": N, "lengths": [...], "points": [x, y, z, ...],
        "header": {key: value, ...}}. Points are float32 values printed as
@@ -53,8 +53,9 @@ def read(path):
 def main():
     if len(sys.argv) == 5 and sys.argv[1] == 'write':
         write(sys.argv[2], int(sys.argv[3]), int(sys.argv[4]))
-    elif len(sys.argv) == 3 and sys.argv[1] == 'read':
-        read(sys.argv[2])
+    elif len(sys.argv) >= 3 and sys.argv[1] == 'read':
+        for path in sys.argv[2:]:
+            read(path)
     else:
         sys.exit(__doc__)
 

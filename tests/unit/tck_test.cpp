@@ -452,6 +452,45 @@ TEST(TckReader, chunksHoldWholeStreamlinesUpToMaxPoints) {
   }
 }
 
+TEST(TckReader, readsStreamlinesThatSpanReadBuffers) {
+  // Several MiB, so streamlines, separators and samples straddle the reader's
+  // 1 MiB buffer refills; one streamline alone is longer than a buffer.
+  test::TempDir dir;
+  Tractogram t = test::smallTractogram(3000, 12, true);
+  t.per_streamline.clear();
+  std::vector<float> longest;
+  for (int i = 0; i < 3 * 150000; ++i) longest.push_back(float(i % 1000) * 0.01f);
+  t.addStreamline(longest.data(), longest.size() / 3);
+  t.addStreamline(nullptr, 0);
+  t.per_point[0].values.resize(t.pointCount(), 0.75f);
+  for (const std::string dt : {"Float32LE", "Float64BE"}) {
+    const std::string path = dir.file("big" + dt + ".tck");
+    writeTractogram(path, t, {.per_point = {{"fa"}}}, {.tck_datatype = dt});
+    const std::string tsf = dir.file("big" + dt + "_fa.tsf");
+    const ReadResult r = readAll(path, {tsf}, 100000);
+    expectSameStreamlines(r.tractogram, t);
+    EXPECT_EQ(r.tractogram.per_point[0].values, t.per_point[0].values);
+    EXPECT_TRUE(r.warnings.empty());
+    // Cut inside the long streamline, and one byte short of the end.
+    const std::string bytes = test::readBytes(path);
+    for (size_t cut : {bytes.size() - 1000000, bytes.size() - 1}) {
+      test::writeBytes(dir.file("cut.tck"), bytes.substr(0, cut));
+      const ReadResult c = readAll(dir.file("cut.tck"), {}, 100000);
+      const bool in_long = cut < bytes.size() - 1;
+      const size_t kept = in_long ? 3000 : t.streamlineCount();
+      ASSERT_EQ(c.tractogram.streamlineCount(), kept);
+      EXPECT_EQ(c.tractogram.offsets, std::vector<uint64_t>(t.offsets.begin(), t.offsets.begin() + kept + 1));
+      ASSERT_EQ(c.warnings.size(), in_long ? 2u : 1u);
+      // After the long streamline come its separator, the empty one's and the terminator.
+      const size_t triplet = dt == "Float32LE" ? 12 : 24;
+      const size_t long_start = bytes.size() - triplet * (150000 + 3);
+      const size_t partial = in_long ? (cut - long_start) / triplet : 0;
+      EXPECT_EQ(c.warnings[0], dir.file("cut.tck") + ": no terminator: file truncated at byte " + std::to_string(cut) +
+                                   ", last partial streamline of " + std::to_string(partial) + " points dropped");
+    }
+  }
+}
+
 // --- writer and round trips ------------------------------------------------
 
 TEST(TckRoundTrip, isExactForEveryDatatype) {
@@ -504,9 +543,10 @@ TEST(TckWriter, streamsChunksAndPatchesTheCountInPlace) {
   const std::string bytes = test::readBytes(path);
   const size_t end = bytes.find("\nEND\n");
   ASSERT_NE(end, std::string::npos);
-  const std::string header = bytes.substr(0, end + 5);
-  EXPECT_EQ(header, "mrtrix tracks\ndatatype: Float32LE\ncount: 00000000000000000030\nfile: . " +
-                        std::to_string(header.size()) + "\nEND\n");
+  // The data starts on a 16-byte boundary after zero padding.
+  const size_t offset = (end + 5 + 15) / 16 * 16;
+  EXPECT_EQ(bytes.substr(0, offset), "mrtrix tracks\ndatatype: Float32LE\ncount: 00000000000000000030\nfile: . " +
+                                         std::to_string(offset) + "\nEND\n" + std::string(offset - end - 5, '\0'));
   expectSameStreamlines(readAll(path).tractogram, t);
 }
 
@@ -683,6 +723,7 @@ TEST(TckTsf, perPointArraysRoundTripThroughSiblingFiles) {
 TEST(TckTsf, writerDropsAnArrayHoldingNaNButKeepsTheTractogram) {
   test::TempDir dir;
   Tractogram t = test::smallTractogram(5, 2, true);
+  t.per_streamline.clear();
   t.per_point[0].values[3] = kNaN;
   std::vector<std::string> warnings;
   writeTractogram(dir.file("n.tck"), t, {.per_point = {{"fa"}}}, {}, &warnings);
@@ -695,12 +736,18 @@ TEST(TckTsf, writerDropsAnArrayHoldingNaNButKeepsTheTractogram) {
 
 // --- nibabel as the outside reference ---------------------------------------
 
-nlohmann::json runReference(const std::string& args) {
+// Runs the reference script; returns its JSON lines (nibabel may also warn on stderr).
+std::vector<nlohmann::json> runReference(const std::string& args) {
   const auto r = test::runCommand(test::pythonWithNibabel() + " " + test::toolPath("tck_reference.py") + " " + args);
   EXPECT_EQ(r.exit_code, 0) << r.output;
-  // nibabel may warn on stderr first: the JSON is the line that starts with '{'.
-  const size_t begin = r.output.rfind("\n{") == std::string::npos ? 0 : r.output.rfind("\n{") + 1;
-  return nlohmann::json::parse(r.output.substr(begin, r.output.find('\n', begin) - begin));
+  std::vector<nlohmann::json> out;
+  size_t begin = 0;
+  while (begin < r.output.size()) {
+    const size_t end = std::min(r.output.find('\n', begin), r.output.size());
+    if (r.output[begin] == '{') out.push_back(nlohmann::json::parse(r.output.substr(begin, end - begin)));
+    begin = end + 1;
+  }
+  return out;
 }
 
 Tractogram fromReference(const nlohmann::json& j) {
@@ -721,7 +768,9 @@ TEST(TckNibabel, readsFilesNibabelWrote) {
   if (test::pythonWithNibabel().empty()) GTEST_SKIP() << "needs /usr/bin/python3 with nibabel";
   test::TempDir dir;
   const std::string path = dir.file("nib.tck");
-  const nlohmann::json ref = runReference("write " + path + " 11 57");
+  const auto refs = runReference("write " + path + " 11 57");
+  ASSERT_EQ(refs.size(), 1u);
+  const nlohmann::json& ref = refs[0];
   const ReadResult r = readAll(path, {}, 100);
   expectSameStreamlines(r.tractogram, fromReference(ref));
   EXPECT_EQ(r.tractogram.streamlineCount(), 57u);
@@ -737,16 +786,22 @@ TEST(TckNibabel, nibabelReadsWhatWeWrite) {
   TractogramHeader like;
   like.properties = {{"command_history", "fibscope convert a.trk b.tck"}, {"step_size", "0.5"}};
   // nibabel reads float32 only, in either byte order.
-  for (const std::string dt : {"Float32LE", "Float32BE"}) {
-    const std::string path = dir.file(dt + ".tck");
-    writeTractogram(path, t, like, {.tck_datatype = dt});
-    const nlohmann::json ref = runReference("read " + path);
+  const std::vector<std::string> datatypes = {"Float32LE", "Float32BE"};
+  std::string paths;
+  for (const auto& dt : datatypes) {
+    writeTractogram(dir.file(dt + ".tck"), t, like, {.tck_datatype = dt});
+    paths += " " + dir.file(dt + ".tck");
+  }
+  const auto refs = runReference("read" + paths);
+  ASSERT_EQ(refs.size(), datatypes.size());
+  for (size_t i = 0; i < datatypes.size(); ++i) {
+    const nlohmann::json& ref = refs[i];
     EXPECT_EQ(ref["count"].get<size_t>(), 73u);
     expectSameStreamlines(fromReference(ref), t);
     EXPECT_EQ(ref["header"]["command_history"], "fibscope convert a.trk b.tck");
     EXPECT_EQ(ref["header"]["step_size"], "0.5");
     EXPECT_EQ(ref["header"]["count"], "00000000000000000073");
-    EXPECT_EQ(ref["header"]["datatype"], dt);
+    EXPECT_EQ(ref["header"]["datatype"], datatypes[i]);
   }
 }
 
