@@ -16,10 +16,11 @@
 
 namespace {
 
-// One input file per process, reused for every input.
+// One input file per process, reused for every input, removed at exit.
 const std::string& inputPath() {
   static const std::string path = [] {
     const char* dir = std::getenv("TMPDIR");
+    std::atexit([] { ::unlink(inputPath().c_str()); });
     return std::string(dir && *dir ? dir : "/tmp") + "/fuzz_trx_" + std::to_string(::getpid()) + ".trx";
   }();
   return path;
