@@ -16,11 +16,11 @@
 
 namespace {
 
-// One input file per process, reused for every input, removed at exit.
+// One input file path per process, reused for every input (the file is
+// removed after each input: libFuzzer may end with _Exit, skipping atexit).
 const std::string& inputPath() {
   static const std::string path = [] {
     const char* dir = std::getenv("TMPDIR");
-    std::atexit([] { ::unlink(inputPath().c_str()); });
     return std::string(dir && *dir ? dir : "/tmp") + "/fuzz_trx_" + std::to_string(::getpid()) + ".trx";
   }();
   return path;
@@ -44,5 +44,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   } catch (const fibscope::Error& e) {
     if (std::string(e.what()).find('\n') != std::string::npos) std::abort();
   }
+  ::unlink(path.c_str());
   return 0;
 }
