@@ -253,11 +253,13 @@ std::vector<TrkNamedRun> decodeTrkNames(const std::array<std::array<char, kTrkNa
     next += run.components;
     runs.push_back(std::move(run));
   }
-  // Components without a name (n_scalars larger than the names account for).
-  for (uint32_t k = next; k < uint32_t(count); ++k) runs.push_back({unnamed_prefix + "_" + std::to_string(k), k, 1});
+  // Components without a name (n_scalars larger than the names account for)
+  // form one array, as nibabel does ("scalars" there, "scalar_<first>" here):
+  // the number of arrays stays bounded whatever the count says.
+  if (next < uint32_t(count))
+    runs.push_back({unnamed_prefix + "_" + std::to_string(next), next, uint32_t(count) - next});
 
-  // Empty and duplicate names would be ambiguous downstream. (A hash set:
-  // n_scalars may be 32767, all unnamed.)
+  // Empty and duplicate names would be ambiguous downstream.
   std::unordered_set<std::string> used;
   for (TrkNamedRun& run : runs) {
     if (run.name.empty()) run.name = unnamed_prefix + "_" + std::to_string(run.first);

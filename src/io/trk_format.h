@@ -87,7 +87,7 @@ struct TrkNamedRun {
 // Splits `count` components into named runs using nibabel's convention: a
 // name field "fa" names one component, "dir\0003" (name, NUL, decimal count)
 // names three; an all-NUL field names none. Components left without a name
-// become one run each, named "<unnamed_prefix>_<component index>". Names that
+// form one run named "<unnamed_prefix>_<its first component>". Names that
 // lie (more components than `count`, malformed counts, duplicates) are
 // repaired and reported through `warnings`. Names are latin-1 in the file.
 std::vector<TrkNamedRun> decodeTrkNames(const std::array<std::array<char, kTrkNameBytes>, kTrkMaxNames>& fields,

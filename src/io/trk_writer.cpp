@@ -214,6 +214,9 @@ void TrkWriter::write(const Tractogram& chunk) {
       const double x = r[0], y = r[1], z = r[2];
       for (int k = 0; k < 3; ++k) {
         const float v = static_cast<float>(a[4 * k] * x + a[4 * k + 1] * y + a[4 * k + 2] * z + a[4 * k + 3]);
+        if (!std::isfinite(v))
+          fail(out_.path(), "streamline " + std::to_string(streamlines_ + s) + " point " + std::to_string(j - first) +
+                                " lies outside the float range of the voxel grid's voxmm coordinates");
         max_voxmm_[k] = std::max(max_voxmm_[k], double(v));
         storeUnaligned<float>(p + 4 * k, v, kSwapOut);
       }

@@ -575,6 +575,9 @@ CellArray VtkReader::parseCells(VtkCursor& c, const std::string& keyword) {
     cells.raw_type = ValueType{Scalar::kInt32, 4};
     cells.interleaved = true;
     for (uint64_t i = 0; i < n; ++i) {
+      if (w >= size)
+        c.failAtOffset(cells.data_offset + 4 * w, label + " declares " + std::to_string(size) +
+                                                      " entries, but they end before cell " + std::to_string(i));
       const int32_t k = loadUnaligned<int32_t>(cells.raw + 4 * w, kHostIsLittleEndian);
       if (k < 0 || uint64_t(k) > size - w - 1)
         c.failAtOffset(cells.data_offset + 4 * w, label + " cell " + std::to_string(i) + " has " + std::to_string(k) +
@@ -591,6 +594,8 @@ CellArray VtkReader::parseCells(VtkCursor& c, const std::string& keyword) {
   }
   cells.ids.reserve(size - n);
   for (uint64_t i = 0; i < n; ++i) {
+    if (w >= size)
+      c.fail(label + " declares " + std::to_string(size) + " entries, but they end before cell " + std::to_string(i));
     int64_t k = 0;
     c.readValues(ValueType{Scalar::kInt32, 4}, 1, &k, label + " cell " + std::to_string(i) + " size");
     if (k < 0 || uint64_t(k) > size - w - 1)

@@ -336,15 +336,15 @@ TEST(TrkReader, decodesNibabelStyleNamesAndNamesTheRest) {
   Tractogram t;
   std::vector<std::string> warnings;
   ASSERT_EQ(readAll(b.save(dir), &t, &warnings), "");
-  ASSERT_EQ(t.per_point.size(), 4u);
+  ASSERT_EQ(t.per_point.size(), 3u);
   EXPECT_EQ(t.per_point[0].name, "rgb");
   EXPECT_EQ(t.per_point[0].components, 3u);
   EXPECT_EQ(t.per_point[0].values, (std::vector<float>{10, 11, 12}));
   EXPECT_EQ(t.per_point[1].name, "fa");
   EXPECT_EQ(t.per_point[1].values, (std::vector<float>{13}));
-  EXPECT_EQ(t.per_point[2].name, "scalar_4");
-  EXPECT_EQ(t.per_point[3].name, "scalar_5");
-  EXPECT_EQ(t.per_point[3].values, (std::vector<float>{15}));
+  EXPECT_EQ(t.per_point[2].name, "scalar_4");  // the unnamed rest, as one array
+  EXPECT_EQ(t.per_point[2].components, 2u);
+  EXPECT_EQ(t.per_point[2].values, (std::vector<float>{14, 15}));
   ASSERT_EQ(t.per_streamline.size(), 2u);
   EXPECT_EQ(t.per_streamline[0].name, "pair");
   EXPECT_EQ(t.per_streamline[0].values, (std::vector<float>{1, 2}));

@@ -186,6 +186,12 @@ TEST(VtkReader, rejectsCellSizesThatDisagreeWithTheSection) {
   expectError(std::string(kHead) + "POINTS 2 float\n0 0 0 1 1 1\nLINES 1 4\n2 0 1\n", "LINES declares 4 entries");
   expectError(std::string(kHead) + "POINTS 2 float\n0 0 0 1 1 1\nLINES 1 3\n5 0 1\n", "cell 0 has 5 points");
   expectError(std::string(kHead) + "POINTS 2 float\n0 0 0 1 1 1\nLINES 3 2\n1 0 1 1\n", "cannot fit");
+  expectError(std::string(kHead) + "POINTS 2 float\n0 0 0 1 1 1\nLINES 3 4\n1 0 1 1\n", "end before cell 2");
+  // The same in binary, where reading on would leave the section (found by fuzz_vtk).
+  std::string binary = "# vtk DataFile Version 3.0\nb\nBINARY\nDATASET POLYDATA\nPOINTS 1 float\n";
+  for (int i = 0; i < 3; ++i) binary += be(0.0f);
+  binary += "\nLINES 3 4\n" + be<int32_t>(1) + be<int32_t>(0) + be<int32_t>(1) + be<int32_t>(0);
+  expectError(binary, "end before cell 2");
 }
 
 TEST(VtkReader, rejectsBadVersion51Offsets) {
