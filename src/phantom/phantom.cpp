@@ -223,7 +223,7 @@ PhantomBundle PhantomGenerator::generate(uint64_t index, std::vector<float>& xyz
   // so each segment carries one rounding only.
   float y = float(-0.5 * double(min_steps_) * step_);
   for (uint64_t k = 0; k <= min_steps_; ++k) {
-    if (k > 0) y = float(double(y) + step_);
+    if (k > 0) y = opaqueFloat(double(y) + step_);
     xyz.push_back(0.0f);
     xyz.push_back(y);
     xyz.push_back(0.0f);

@@ -46,27 +46,39 @@ inline uint64_t mix64(uint64_t z) {
   return z ^ (z >> 31);
 }
 
+__extension__ using Uint128 = unsigned __int128;
+
+// The sequential stream of one streamline: wyrand (Wang Yi's 64-bit
+// generator: a Weyl sequence folded through one 64x64->128-bit multiply),
+// which passes BigCrush and PractRand and costs a handful of instructions,
+// against the tracker's three normals per step. Its 64-bit state is the
+// streamline's key, so a stream depends on (seed, index, attempt) only.
 class Rng {
  public:
   explicit Rng(uint64_t key) : state_(key) {}
   uint64_t next() {
-    state_ += 0x9e3779b97f4a7c15ull;
-    return mix64(state_);
+    state_ += 0xa0761d6478bd642full;
+    const Uint128 m = Uint128(state_) * Uint128(state_ ^ 0xe7037ed1a0b428dbull);
+    return uint64_t(m >> 64) ^ uint64_t(m);
   }
   // Uniform in [0, 1) with 53 random bits.
   double uniform() { return double(next() >> 11) * 0x1.0p-53; }
   double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
-  // Approximately standard normal: the Irwin-Hall sum of four 16-bit uniforms
-  // taken from one 64-bit draw, centred and scaled to unit variance. Its
-  // support is bounded (|g| <= 2 * sqrt(3) = 3.46), which keeps the tracker's
-  // jitter from ever producing a wild outlier, and it costs a few integer
-  // operations instead of a log and a sqrt (Box-Muller).
-  double normal() {
+  // Two approximately standard normals from one draw, each the Irwin-Hall
+  // sum of four 8-bit uniforms, centred and scaled to unit variance, summed
+  // in SIMD-within-a-register lanes. The support is bounded
+  // (|g| <= 3.45), which keeps the tracker's jitter free of wild outliers,
+  // and it costs a few integer operations instead of Box-Muller's log,
+  // sqrt and trigonometry; the 1/148 sigma granularity is far below
+  // anything visible in a fiber.
+  void normal2(double& a, double& b) {
     const uint64_t r = next();
-    const uint64_t pairs = (r & 0x0000ffff0000ffffull) + ((r >> 16) & 0x0000ffff0000ffffull);
-    const double sum = double((pairs & 0xffffffffull) + (pairs >> 32));
-    // mean 4 * 65535 / 2, variance 4 * (65536^2 - 1) / 12
-    return (sum - 131070.0) * (1.0 / 37837.22692);
+    const uint64_t pairs = (r & 0x00ff00ff00ff00ffull) + ((r >> 8) & 0x00ff00ff00ff00ffull);
+    const uint64_t quads = (pairs & 0x0000ffff0000ffffull) + ((pairs >> 16) & 0x0000ffff0000ffffull);
+    // mean 4 * 255 / 2, variance 4 * (256^2 - 1) / 12
+    constexpr double kMean = 510.0, kInverseSigma = 1.0 / 147.80054127;
+    a = (double(quads & 0xffffffffu) - kMean) * kInverseSigma;
+    b = (double(quads >> 32) - kMean) * kInverseSigma;
   }
 
  private:
@@ -80,10 +92,33 @@ inline uint64_t streamlineKey(uint64_t seed, uint64_t index, uint32_t attempt) {
   return mix64(k ^ (uint64_t(attempt) * 0xd1b54a32d192ed03ull + 0x2545f4914f6cdd1dull));
 }
 
-// The ellipsoid of the phantom: (x/a)^2 + (y/b)^2 + (z/c)^2 <= 1.
+// float(value), as an opaque value the optimiser cannot see through.
+// GCC 12.2 at -O2 and above (its SLP vectoriser) turns double(float(x))
+// back into x when x, y of a point are rounded together, so a walk that
+// goes on from its stored float points would silently go on from the
+// unrounded doubles and every segment would carry two roundings instead of
+// one (found by Phantom.everySegmentHasTheStepLength; clang 14 is correct).
+// An empty asm that claims to modify the float hides its origin.
+inline float opaqueFloat(double value) {
+  float f = float(value);
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+  asm("" : "+x"(f));
+#elif defined(__GNUC__) && defined(__aarch64__)
+  asm("" : "+w"(f));
+#elif defined(__GNUC__)
+  asm("" : "+m"(f));
+#endif
+  return f;
+}
+
+// The ellipsoid of the phantom: (x/a)^2 + (y/b)^2 + (z/c)^2 <= 1, with
+// multiplications only: the tracker evaluates it at every step, and
+// divisions would compete for the divider with the step's normalisation.
+inline constexpr double kInverseSquaredAxes[3] = {1.0 / (kPhantomSemiAxesMm[0] * kPhantomSemiAxesMm[0]),
+                                                  1.0 / (kPhantomSemiAxesMm[1] * kPhantomSemiAxesMm[1]),
+                                                  1.0 / (kPhantomSemiAxesMm[2] * kPhantomSemiAxesMm[2])};
 inline double ellipsoidMeasure(double x, double y, double z) {
-  const double u = x / kPhantomSemiAxesMm[0], v = y / kPhantomSemiAxesMm[1], w = z / kPhantomSemiAxesMm[2];
-  return u * u + v * v + w * w;
+  return x * x * kInverseSquaredAxes[0] + y * y * kInverseSquaredAxes[1] + z * z * kInverseSquaredAxes[2];
 }
 // Relative radius: 1 on the surface, 0.9 at 90% of the way from the centre.
 inline double relativeRadius(Vec3 p) { return std::sqrt(ellipsoidMeasure(p.x, p.y, p.z)); }
@@ -94,11 +129,14 @@ inline Vec3 atRelativeRadius(Vec3 p, double rho) { return (rho / relativeRadius(
 Vec3 shellPoint(Vec3 origin, Vec3 direction, double rho);
 
 // A polyline sampled from a fiber's smooth guide curve, with each segment's
-// unit tangent, its length and the arc length at its start.
+// unit tangent and the arc length at its start and end.
 struct Guide {
   std::vector<Vec3> points;
-  std::vector<Vec3> tangents;    // tangents[i] = unit (points[i+1] - points[i])
-  std::vector<double> arc;       // arc[i] = arc length at points[i]; arc.size() == points.size()
+  std::vector<Vec3> tangents;  // tangents[i] = unit (points[i+1] - points[i])
+  std::vector<double> arc;     // arc[i] = arc length at points[i]; arc.size() == points.size()
+  // ends[i] = arc[i + 1], except the last, which is +infinity: walks along
+  // the guide stop on the last segment without a bounds check.
+  std::vector<double> ends;
   double length() const { return arc.empty() ? 0.0 : arc.back(); }
 };
 

@@ -2,6 +2,7 @@
 // a constant-step walk along it with probabilistic-tracker-like jitter.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "phantom/phantom_internal.h"
 
@@ -22,6 +23,7 @@ void buildGuide(const std::vector<Vec3>& controls, double spacing, Guide& guide)
   guide.points.clear();
   guide.tangents.clear();
   guide.arc.clear();
+  guide.ends.clear();
   const size_t n = controls.size();
   auto control = [&](ptrdiff_t i) -> Vec3 {
     // Reflected phantom points beyond both ends make the end spans start and
@@ -37,15 +39,17 @@ void buildGuide(const std::vector<Vec3>& controls, double spacing, Guide& guide)
     const double t0 = 0, t1 = t0 + std::sqrt(std::max(norm(p1 - p0), 1e-9)),
                  t2 = t1 + std::sqrt(std::max(norm(p2 - p1), 1e-9)), t3 = t2 + std::sqrt(std::max(norm(p3 - p2), 1e-9));
     const size_t samples = std::max<size_t>(1, size_t(std::ceil(norm(p2 - p1) / spacing)));
+    const double r10 = 1.0 / (t1 - t0), r21 = 1.0 / (t2 - t1), r32 = 1.0 / (t3 - t2), r20 = 1.0 / (t2 - t0),
+                 r31 = 1.0 / (t3 - t1);
     for (size_t k = 0; k < samples; ++k) {
       // Barry-Goldman pyramid evaluation of the Catmull-Rom span at t.
       const double t = t1 + (t2 - t1) * double(k) / double(samples);
-      const Vec3 a1 = ((t1 - t) / (t1 - t0)) * p0 + ((t - t0) / (t1 - t0)) * p1;
-      const Vec3 a2 = ((t2 - t) / (t2 - t1)) * p1 + ((t - t1) / (t2 - t1)) * p2;
-      const Vec3 a3 = ((t3 - t) / (t3 - t2)) * p2 + ((t - t2) / (t3 - t2)) * p3;
-      const Vec3 b1 = ((t2 - t) / (t2 - t0)) * a1 + ((t - t0) / (t2 - t0)) * a2;
-      const Vec3 b2 = ((t3 - t) / (t3 - t1)) * a2 + ((t - t1) / (t3 - t1)) * a3;
-      guide.points.push_back(((t2 - t) / (t2 - t1)) * b1 + ((t - t1) / (t2 - t1)) * b2);
+      const Vec3 a1 = ((t1 - t) * r10) * p0 + ((t - t0) * r10) * p1;
+      const Vec3 a2 = ((t2 - t) * r21) * p1 + ((t - t1) * r21) * p2;
+      const Vec3 a3 = ((t3 - t) * r32) * p2 + ((t - t2) * r32) * p3;
+      const Vec3 b1 = ((t2 - t) * r20) * a1 + ((t - t0) * r20) * a2;
+      const Vec3 b2 = ((t3 - t) * r31) * a2 + ((t - t1) * r31) * a3;
+      guide.points.push_back(((t2 - t) * r21) * b1 + ((t - t1) * r21) * b2);
     }
   }
   guide.points.push_back(controls[n - 1]);
@@ -63,18 +67,20 @@ void buildGuide(const std::vector<Vec3>& controls, double spacing, Guide& guide)
     guide.tangents.push_back((1.0 / length) * chord);
     guide.arc.push_back(guide.arc.back() + length);
   }
+  guide.ends.assign(guide.arc.begin() + 1, guide.arc.end());
+  if (!guide.ends.empty()) guide.ends.back() = std::numeric_limits<double>::infinity();
 }
 
 size_t trackAlongGuide(const Guide& guide, double start_arc, size_t steps, const TrackerParameters& params, Rng& rng,
                        std::vector<float>& xyz) {
-  const size_t segments = guide.tangents.size();
   const Vec3* points = guide.points.data();
   const Vec3* tangents = guide.tangents.data();
   const double* arc = guide.arc.data();
+  const double* ends = guide.ends.data();
 
   // Segment holding the start.
   size_t seg = 0;
-  while (seg + 1 < segments && arc[seg + 1] <= start_arc) ++seg;
+  while (start_arc >= ends[seg]) ++seg;
   Vec3 start = points[seg] + (start_arc - arc[seg]) * tangents[seg];
   Vec3 dir = tangents[seg];
 
@@ -84,9 +90,9 @@ size_t trackAlongGuide(const Guide& guide, double start_arc, size_t steps, const
   const size_t base = xyz.size();
   xyz.resize(base + 3 * (steps + 1));
   float* out = xyz.data() + base;
-  out[0] = float(start.x);
-  out[1] = float(start.y);
-  out[2] = float(start.z);
+  out[0] = opaqueFloat(start.x);
+  out[1] = opaqueFloat(start.y);
+  out[2] = opaqueFloat(start.z);
   if (ellipsoidMeasure(out[0], out[1], out[2]) > 1.0) {
     xyz.resize(base);
     return 0;
@@ -96,36 +102,48 @@ size_t trackAlongGuide(const Guide& guide, double start_arc, size_t steps, const
 
   size_t target_seg = seg;
   const double inv_lookahead = 1.0 / params.lookahead;
-  for (size_t s = 0; s < steps; ++s) {
-    // Where the fiber is along its guide: its projection on the current guide
-    // segment, moving on while it has passed the segment's end.
-    double along = dot(pos - points[seg], tangents[seg]);
-    while (seg + 1 < segments && along > arc[seg + 1] - arc[seg]) {
+  const bool jitter = params.jitter_sigma > 0;
+  // Pure pursuit: the fiber steers towards the guide point `lookahead` mm
+  // ahead of its projection on the guide (extrapolated along the last
+  // tangent past the guide's end), so a fiber that drifts sideways is pulled
+  // back within a few millimetres. `want` is that target's direction, scaled
+  // by 1 / lookahead: the fiber stays within a fraction of a millimetre of
+  // its guide, so |target - pos| is the lookahead to within a few percent,
+  // and dividing by the constant instead of the distance only changes the
+  // steering strength by as much while saving a square root and a division.
+  auto pursue = [&] {
+    // Projection on the current guide segment, moving on while the fiber has
+    // passed the segment's end.
+    double along = arc[seg] + dot(pos - points[seg], tangents[seg]);
+    while (along > ends[seg]) {
       ++seg;
-      along = dot(pos - points[seg], tangents[seg]);
+      along = arc[seg] + dot(pos - points[seg], tangents[seg]);
     }
-    // Pure pursuit: steer towards the guide point `lookahead` mm ahead
-    // (extrapolated along the last tangent past the guide's end). A fiber
-    // that drifts sideways is pulled back within a few millimetres; the
-    // direction relaxes towards the target at rate `steer` per step, which
-    // with steer = step / (lookahead / 4) is critically damped.
-    const double target_arc = arc[seg] + along + params.lookahead;
+    const double target_arc = along + params.lookahead;
     if (target_seg < seg) target_seg = seg;
-    while (target_seg + 1 < segments && arc[target_seg + 1] <= target_arc) ++target_seg;
+    while (target_arc >= ends[target_seg]) ++target_seg;
     const Vec3 target = points[target_seg] + (target_arc - arc[target_seg]) * tangents[target_seg];
-    // The target is `lookahead` mm ahead along the guide and the fiber stays
-    // within a fraction of a millimetre of it, so |target - pos| is the
-    // lookahead to within a few percent: dividing by the constant instead
-    // of the distance only changes the steering strength by as much, and
-    // takes a square root and a division off the step's dependency chain.
-    const Vec3 want = inv_lookahead * (target - pos);
+    return inv_lookahead * (target - pos);
+  };
 
-    // Relaxation towards the target plus isotropic jitter; the component of
-    // the jitter along `dir` only changes the length, which normalising
-    // removes, so the turn is the perpendicular part: per-axis sigma.
+  Vec3 want = pursue();
+  for (size_t s = 0; s < steps; ++s) {
+    // Relaxation towards the target at rate `steer` per step (with steer =
+    // step / (lookahead / 4) the pursuit is critically damped) plus
+    // isotropic jitter; the component of the jitter along `dir` only
+    // changes the length, which normalising removes, so the turn is the
+    // perpendicular part: per-axis sigma.
+    //
+    // `want` was seen from the previous point: one step of lag, invisible
+    // against a millimetre-scale pursuit, that takes the pursuit off the
+    // dependency chain position -> direction -> position, so the processor
+    // overlaps it with this step's normalisation (about twice as fast).
     Vec3 next = dir + params.steer * (want - dir);
-    if (params.jitter_sigma > 0) {
-      const double gx = rng.normal(), gy = rng.normal(), gz = rng.normal();
+    want = pursue();
+    if (jitter) {
+      double gx, gy, gz, unused;
+      rng.normal2(gx, gy);
+      rng.normal2(gz, unused);
       next = next + params.jitter_sigma * Vec3{gx, gy, gz};
     }
     next = (1.0 / norm(next)) * next;
@@ -145,7 +163,7 @@ size_t trackAlongGuide(const Guide& guide, double start_arc, size_t steps, const
     }
 
     const Vec3 p = pos + params.step * next;
-    const float qx = float(p.x), qy = float(p.y), qz = float(p.z);
+    const float qx = opaqueFloat(p.x), qy = opaqueFloat(p.y), qz = opaqueFloat(p.z);
     // Fibers end at the brain's surface: the first point that would be
     // outside the ellipsoid is not stored.
     if (ellipsoidMeasure(qx, qy, qz) > 1.0) break;
