@@ -13,8 +13,11 @@
 //                          n_connectivity) and CONNECTIVITY type.
 // Each line cell is a streamline whose points are gathered by index, so the
 // POINTS array (and point data) is held in memory; streamlines are handed
-// out in chunks. Points are taken as RAS+ mm. Binary cell arrays are read
-// from the map when gathered; ASCII ones are parsed once at open.
+// out in chunks. Points are taken as RAS+ mm, except in files whose title
+// says "SPACE=LPS" (3D Slicer and SlicerDMRI write legacy files with a
+// "SPACE=RAS" or "SPACE=LPS" title), where x and y are negated. Binary cell
+// arrays are read from the map when gathered; ASCII ones are parsed once at
+// open.
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -402,6 +405,7 @@ class VtkReader final : public TractogramReader {
   bool cell_data_warned_ = false;
   uint64_t header_end_ = 0;
   uint64_t next_line_ = 0;
+  bool lps_ = false;  // points are stored in LPS: negate x and y
 };
 
 VtkReader::VtkReader(const std::string& path) : file_(path) {
@@ -431,6 +435,13 @@ VtkReader::VtkReader(const std::string& path) : file_(path) {
   c.restOfLine();
 
   header_.properties = {{"vtk.version", version}, {"vtk.title", title}, {"vtk.encoding", encoding}};
+  const std::string upper_title = upperCase(title);
+  const size_t space_at = upper_title.find("SPACE=");
+  if (space_at != std::string::npos) {
+    const std::string space = upper_title.substr(space_at + 6, 3);
+    if (space == "LPS" || space == "RAS") header_.properties.emplace_back("vtk.space", space);
+    lps_ = space == "LPS";
+  }
   parse(c);
   header_end_ = c.offset();
 
@@ -783,7 +794,9 @@ bool VtkReader::read(Tractogram& chunk, size_t max_points) {
       if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
         fail(header_.path, "line " + std::to_string(i) + " uses point " + std::to_string(id) +
                                ", which has a non-finite coordinate");
-      std::memcpy(out + 3 * j, p, 3 * sizeof(float));
+      out[3 * j + 0] = lps_ ? -p[0] : p[0];
+      out[3 * j + 1] = lps_ ? -p[1] : p[1];
+      out[3 * j + 2] = p[2];
       for (size_t a = 0; a < point_arrays_.size(); ++a) {
         const uint32_t n = point_arrays_[a].components;
         const float* v = point_arrays_[a].values.data() + uint64_t(id) * n;

@@ -108,6 +108,22 @@ TEST(VtkReader, readsHandWrittenClassicAsciiFile) {
   EXPECT_FALSE(h.space.known);
 }
 
+TEST(VtkReader, convertsSlicerLpsFilesToRas) {
+  TempDir dir;
+  const std::string text =
+      "# vtk DataFile Version 4.1\n3D Slicer output. SPACE=LPS\nASCII\nDATASET POLYDATA\n"
+      "POINTS 2 float\n1 2 3 -4 -5 6\nLINES 1 3\n2 0 1\n";
+  Tractogram t;
+  TractogramHeader h;
+  ASSERT_EQ(readAll(save(dir, text), &t, nullptr, &h), "");
+  EXPECT_EQ(t.positions, (std::vector<float>{-1, -2, 3, 4, 5, 6}));
+  EXPECT_EQ(h.property("vtk.space"), "LPS");
+  std::string ras = text;
+  ras.replace(ras.find("LPS"), 3, "RAS");
+  ASSERT_EQ(readAll(save(dir, ras, "ras.vtk"), &t), "");
+  EXPECT_EQ(t.positions, (std::vector<float>{1, 2, 3, -4, -5, 6}));
+}
+
 TEST(VtkReader, chunksHoldWholeStreamlines) {
   TempDir dir;
   auto reader = openVtk(save(dir, kClassicAscii));
