@@ -160,7 +160,11 @@ PhantomGenerator::PhantomGenerator(const PhantomOptions& options) : options_(opt
     running += weights[i];
     cumulative_weights_[i] = running / total;
   }
-  cumulative_weights_.back() = 1.0;
+  // From the last bundle with a weight on, exactly 1: rounding must never
+  // let a uniform draw in [0, 1) select a trailing bundle of weight 0.
+  size_t last = kPhantomBundleCount - 1;
+  while (last > 0 && weights[last] == 0.0) --last;
+  for (size_t i = last; i < kPhantomBundleCount; ++i) cumulative_weights_[i] = 1.0;
 
   step_ = options_.step_mm;
   min_steps_ = std::max<uint64_t>(1, uint64_t(std::ceil(options_.min_length_mm / step_ - 1e-9)));
@@ -214,10 +218,11 @@ PhantomBundle PhantomGenerator::generate(uint64_t index, std::vector<float>& xyz
     if (points >= min_steps_ + 1) return bundle;
     xyz.resize(base);  // left the ellipsoid too early: try another fiber
   }
-  // Never reached with the built-in anatomy (the attempts above fail
-  // independently, each rarely), but a generator must not fail: a straight
-  // anterior-posterior fiber through the centre, which fits the ellipsoid
-  // for every allowed minimum length (<= 150 mm < 170 mm).
+  // Only reached when the weights leave no bundle long enough for
+  // min_length_mm (with the defaults, attempts fail independently and
+  // rarely), but a generator must not fail: a straight anterior-posterior
+  // fiber through the centre, which fits the ellipsoid for every allowed
+  // minimum length (<= 150 mm < 170 mm).
   if (retries) *retries = kPhantomMaxRetries;
   // Each point is one step from the stored previous one, as in the tracker,
   // so each segment carries one rounding only.

@@ -121,10 +121,12 @@ class PhantomGenerator {
   // Appends the points (x, y, z floats, RAS+ mm) of streamline `index` to
   // `xyz` and returns its bundle. Depends only on the options and `index`
   // (any index, also beyond options().streamlines). `retries`, when given,
-  // receives how many drawn fibers were discarded first because they left
-  // the ellipsoid before reaching min_length_mm; kPhantomMaxRetries means
+  // receives how many drawn fibers were discarded first because they could
+  // not reach min_length_mm (a guide too short, or the fiber left the
+  // ellipsoid early; about 1% with the defaults). kPhantomMaxRetries means
   // none succeeded and a straight anterior-posterior fiber through the
-  // centre was returned instead (a guarantee, not seen with these bundles).
+  // centre was returned instead, which keeps every guarantee; it only
+  // happens when the weights leave no bundle long enough for min_length_mm.
   PhantomBundle generate(uint64_t index, std::vector<float>& xyz, PhantomScratch& scratch,
                          unsigned* retries = nullptr) const;
 
@@ -133,16 +135,11 @@ class PhantomGenerator {
   // per-streamline array yet; it must otherwise be out.per_streamline[0]).
   void generateRange(uint64_t first, uint64_t count, Tractogram& out, PhantomScratch& scratch) const;
 
-  // Expected mean number of points per streamline under these options,
-  // measured once on a fixed sample; used to size chunks.
-  double meanPointsEstimate() const { return mean_points_estimate_; }
-
  private:
   PhantomOptions options_;
   std::array<double, kPhantomBundleCount> cumulative_weights_{};
   double step_ = 0.1;
   uint64_t min_steps_ = 0, max_steps_ = 0;
-  double mean_points_estimate_ = 0;
   struct Tracker;
   std::shared_ptr<const Tracker> tracker_;
 };
