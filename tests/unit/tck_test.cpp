@@ -278,7 +278,6 @@ TEST(TckReader, readsFileEndingAfterASeparatorWithAWarning) {
 
 TEST(TckReader, everyTruncatedPrefixReadsAPrefixOrThrows) {
   test::TempDir dir;
-  const std::string path = dir.file("prefix.tck");
   for (const std::string dt : {"Float32LE", "Float64BE"}) {
     TrackSpec spec;
     spec.streamlines = {{1, 2, 3, 4, 5, 6}, {}, {7, 8, 9}, {10, 11, 12, 13, 14, 15, 16, 17, 18}};
@@ -290,6 +289,8 @@ TEST(TckReader, everyTruncatedPrefixReadsAPrefixOrThrows) {
     const Tractogram expected = fromSamples(spec.streamlines);
     for (size_t n = 0; n <= full.size(); ++n) {
       SCOPED_TRACE(dt + " prefix of " + std::to_string(n) + " bytes");
+      // A fresh name each time: rewriting one file in place makes ext4 flush it on close (slow).
+      const std::string path = dir.file(dt + "-" + std::to_string(n) + ".tck");
       test::writeBytes(path, full.substr(0, n));
       try {
         const ReadResult r = readAll(path);
@@ -310,6 +311,7 @@ TEST(TckReader, everyTruncatedPrefixReadsAPrefixOrThrows) {
         // Once the whole header is there, a cut file reads with a warning.
         EXPECT_LT(n, data_offset) << e.what();
       }
+      std::filesystem::remove(path);
     }
   }
 }
@@ -736,9 +738,15 @@ TEST(TckTsf, writerDropsAnArrayHoldingNaNButKeepsTheTractogram) {
 
 // --- nibabel as the outside reference ---------------------------------------
 
+// Looked up once: each lookup starts Python and imports nibabel.
+const std::string& python() {
+  static const std::string path = test::pythonWithNibabel();
+  return path;
+}
+
 // Runs the reference script; returns its JSON lines (nibabel may also warn on stderr).
 std::vector<nlohmann::json> runReference(const std::string& args) {
-  const auto r = test::runCommand(test::pythonWithNibabel() + " " + test::toolPath("tck_reference.py") + " " + args);
+  const auto r = test::runCommand(python() + " " + test::toolPath("tck_reference.py") + " " + args);
   EXPECT_EQ(r.exit_code, 0) << r.output;
   std::vector<nlohmann::json> out;
   size_t begin = 0;
@@ -765,7 +773,7 @@ Tractogram fromReference(const nlohmann::json& j) {
 }
 
 TEST(TckNibabel, readsFilesNibabelWrote) {
-  if (test::pythonWithNibabel().empty()) GTEST_SKIP() << "needs /usr/bin/python3 with nibabel";
+  if (python().empty()) GTEST_SKIP() << "needs /usr/bin/python3 with nibabel";
   test::TempDir dir;
   const std::string path = dir.file("nib.tck");
   const auto refs = runReference("write " + path + " 11 57");
@@ -780,7 +788,7 @@ TEST(TckNibabel, readsFilesNibabelWrote) {
 }
 
 TEST(TckNibabel, nibabelReadsWhatWeWrite) {
-  if (test::pythonWithNibabel().empty()) GTEST_SKIP() << "needs /usr/bin/python3 with nibabel";
+  if (python().empty()) GTEST_SKIP() << "needs /usr/bin/python3 with nibabel";
   test::TempDir dir;
   const Tractogram t = test::smallTractogram(73, 9);
   TractogramHeader like;
