@@ -8,6 +8,8 @@ and json only.
   read PATH                reads a TRX (zip or directory) and prints JSON:
                            counts, dtypes, every value, member compression
   zip DIR OUT              zips a TRX directory (--method, --top-folder)
+  batch                    runs one command line per stdin line in this
+                           process (saves interpreter start-up), output per line
   half-to-float OUT        all 65536 float16 bit patterns as float32 (LE)
   float-to-half IN OUT     float32 (LE) file -> float16 bits (LE), numpy rounding
 
@@ -219,7 +221,16 @@ def cmd_float_to_half(args):
         np.fromfile(args.input, dtype="<f4").astype("<f2").view("<u2").tofile(args.out)
 
 
-def main():
+def cmd_batch(args):
+    parser = make_parser()
+    for line in sys.stdin:
+        if line.strip():
+            sub = parser.parse_args(line.split())
+            sub.func(sub)
+            sys.stdout.flush()
+
+
+def make_parser():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True)
     m = sub.add_parser("make")
@@ -252,7 +263,13 @@ def main():
     f.add_argument("input")
     f.add_argument("out")
     f.set_defaults(func=cmd_float_to_half)
-    args = p.parse_args()
+    b = sub.add_parser("batch")
+    b.set_defaults(func=cmd_batch)
+    return p
+
+
+def main():
+    args = make_parser().parse_args()
     args.func(args)
 
 
