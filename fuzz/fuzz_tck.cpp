@@ -33,7 +33,9 @@ const Paths& paths() {
     // ext4 flushes it on close, which would cap the fuzzer at ~100 runs/s.
     const char* tmp = std::getenv("TMPDIR");
     struct stat st {};
-    const std::string dir = ::stat("/dev/shm", &st) == 0 && S_ISDIR(st.st_mode) ? "/dev/shm" : tmp && *tmp ? tmp : "/tmp";
+    const std::string dir = ::stat("/dev/shm", &st) == 0 && S_ISDIR(st.st_mode) ? "/dev/shm"
+                            : tmp && *tmp                                       ? tmp
+                                                                                : "/tmp";
     const std::string prefix = dir + "/fuzz_tck." + std::to_string(::getpid()) + ".";
     Paths q;
     q.tck = prefix + "input.tck";

@@ -1,18 +1,17 @@
 #include "io/tck_format.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cfloat>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <limits>
-
-#include <fcntl.h>
-#include <unistd.h>
-
-#include <algorithm>
-#include <cerrno>
 
 #include "core/error.h"
 
@@ -72,8 +71,8 @@ size_t findNonFiniteWords(const uint8_t* p, size_t n, Word mask) {
   // a 64-bit sample matches when both of its lanes do (its other lane of the
   // mask is zero, so it always compares equal). The exact index is found by
   // the scalar loop below, which starts in the step that has a hit.
-  const __m128i m = sizeof(Word) == 4 ? _mm_set1_epi32(static_cast<int>(mask))
-                                      : _mm_set1_epi64x(static_cast<long long>(mask));
+  const __m128i m =
+      sizeof(Word) == 4 ? _mm_set1_epi32(static_cast<int>(mask)) : _mm_set1_epi64x(static_cast<long long>(mask));
   constexpr size_t kStep = 64 / sizeof(Word);
   for (; i + kStep <= n; i += kStep) {
     const uint8_t* q = p + i * sizeof(Word);
@@ -123,7 +122,8 @@ TckHeaderInfo parseTckHeader(const MappedFile& file, std::string_view magic) {
   const std::string_view all = file.view();
   const bool want_tck = magic == kTckMagic;
   const char* what = want_tck ? ".tck" : ".tsf";
-  if (all.empty()) fail(path, std::string("empty file, expected a ") + what + " header starting with '" + std::string(magic) + "'");
+  if (all.empty())
+    fail(path, std::string("empty file, expected a ") + what + " header starting with '" + std::string(magic) + "'");
 
   size_t cursor = 0;
   // Returns the next line without its '\n'; `terminated` is false for a
@@ -173,11 +173,13 @@ TckHeaderInfo parseTckHeader(const MappedFile& file, std::string_view magic) {
 
   const auto datatype = singleValue(path, info, "datatype");
   if (!datatype)
-    fail(path, "no datatype specified (expected a 'datatype: Float32LE' line; Float32BE, Float64LE and Float64BE are "
-               "also allowed)");
+    fail(path,
+         "no datatype specified (expected a 'datatype: Float32LE' line; Float32BE, Float64LE and Float64BE are "
+         "also allowed)");
   const auto type = parseTckDataType(*datatype);
   if (!type)
-    fail(path, "datatype " + quoted(*datatype) + " is not supported (expected Float32LE, Float32BE, Float64LE or Float64BE)");
+    fail(path,
+         "datatype " + quoted(*datatype) + " is not supported (expected Float32LE, Float32BE, Float64LE or Float64BE)");
   info.datatype = *type;
 
   const auto file_line = singleValue(path, info, "file");
@@ -207,7 +209,6 @@ TckHeaderInfo parseTckHeader(const MappedFile& file, std::string_view magic) {
 
   for (const auto& [k, v] : info.properties) {
     if (k != "count") continue;
-    info.count_text = v;
     const auto n = parseUnsigned(v);
     if (n && *n <= static_cast<uint64_t>(std::numeric_limits<int64_t>::max())) {
       info.count = static_cast<int64_t>(*n);
@@ -229,8 +230,8 @@ size_t findNonFinite(const uint8_t* p, size_t n, const TckDataType& type) {
 }
 
 SampleKind classifySample(const uint8_t* p, const TckDataType& type) {
-  const double v = type.bytes == 4 ? double(loadUnaligned<float>(p, type.needsSwap()))
-                                   : loadUnaligned<double>(p, type.needsSwap());
+  const double v =
+      type.bytes == 4 ? double(loadUnaligned<float>(p, type.needsSwap())) : loadUnaligned<double>(p, type.needsSwap());
   if (std::isnan(v)) return SampleKind::kNaN;
   if (std::isinf(v)) return SampleKind::kInf;
   return SampleKind::kFinite;
@@ -351,14 +352,16 @@ TckHeaderText makeTckHeader(std::string_view magic, const std::vector<std::pair<
     // would come back as something else.
     const bool unwritable = key.empty() || key.find_first_of(":\n\r") != std::string::npos || strip(key) != key;
     if (unwritable) {
-      if (dropped) dropped->push_back("header key " + quoted(key) + " cannot be stored in a track file header; dropped");
+      if (dropped)
+        dropped->push_back("header key " + quoted(key) + " cannot be stored in a track file header; dropped");
       continue;
     }
     // MRtrix joins repeated keys with newlines; write them back as repeats.
     size_t begin = 0;
     while (true) {
       const size_t nl = value.find('\n', begin);
-      const std::string_view line = strip(std::string_view(value).substr(begin, nl == std::string::npos ? nl : nl - begin));
+      const std::string_view line =
+          strip(std::string_view(value).substr(begin, nl == std::string::npos ? nl : nl - begin));
       h.append(key).append(": ").append(line).append("\n");
       if (nl == std::string::npos) break;
       begin = nl + 1;
@@ -368,20 +371,11 @@ TckHeaderText makeTckHeader(std::string_view magic, const std::vector<std::pair<
   h.append("count: ");
   out.count_offset = h.size();
   h.append(formatTckCount(0)).append("\n");
-  // The offset counts its own digits. The data starts on a 16-byte boundary
-  // (zero padding after END, as MRtrix leaves): samples are then aligned in
-  // the map and native float32 is copied out in bulk.
-  const size_t end = h.size() + std::strlen("file: . ") + std::strlen("\nEND\n");
-  size_t offset = end + 1;
-  while (true) {
-    const size_t header_end = end + std::to_string(offset).size();
-    const size_t aligned = (header_end + 15) / 16 * 16;
-    if (aligned == offset) break;
-    offset = aligned;
-  }
-  const std::string digits = std::to_string(offset);
-  h.append("file: . ").append(digits).append("\nEND\n");
-  h.append(offset - h.size(), '\0');
+  // The offset counts its own digits: grow the digit count until stable.
+  const size_t base = h.size() + std::strlen("file: . ") + std::strlen("\nEND\n");
+  size_t digits = 1;
+  while (std::to_string(base + digits).size() != digits) ++digits;
+  h.append("file: . ").append(std::to_string(base + digits)).append("\nEND\n");
   return out;
 }
 

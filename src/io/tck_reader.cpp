@@ -26,9 +26,12 @@ namespace {
 
 const char* kindName(SampleKind kind) {
   switch (kind) {
-    case SampleKind::kNaN: return "NaN";
-    case SampleKind::kInf: return "Inf";
-    case SampleKind::kFinite: break;
+    case SampleKind::kNaN:
+      return "NaN";
+    case SampleKind::kInf:
+      return "Inf";
+    case SampleKind::kFinite:
+      break;
   }
   return "a number";
 }
@@ -53,7 +56,7 @@ class TckReader final : public TractogramReader {
   std::unique_ptr<TrackDataStream> data_;
   TckDataType type_;
   size_t triplet_bytes_ = 12;
-  uint64_t streamlines_ = 0; // read so far
+  uint64_t streamlines_ = 0;  // read so far
   bool has_count_line_ = false;
   int64_t header_count_ = -1;
   bool at_end_ = false;
@@ -74,8 +77,8 @@ TckReader::TckReader(const std::string& path, const std::vector<std::string>& ts
   type_ = info.datatype;
   triplet_bytes_ = 3 * type_.bytes;
   data_ = std::make_unique<TrackDataStream>(path, info.data_offset, header_.file_bytes);
-  has_count_line_ = std::any_of(info.properties.begin(), info.properties.end(),
-                                [](const auto& kv) { return kv.first == "count"; });
+  has_count_line_ =
+      std::any_of(info.properties.begin(), info.properties.end(), [](const auto& kv) { return kv.first == "count"; });
   header_count_ = info.count;
   if (header_count_ >= 0) {
     // Every streamline takes at least its separator triplet.
@@ -85,8 +88,7 @@ TckReader::TckReader(const std::string& path, const std::vector<std::string>& ts
       header_.declared_streamlines = header_count_;
     } else {
       warn("header count " + std::to_string(header_count_) + " is impossible: " + std::to_string(data_bytes) +
-           " bytes of data hold at most " + std::to_string(most) +
-           " streamlines");
+           " bytes of data hold at most " + std::to_string(most) + " streamlines");
     }
   }
 
@@ -113,7 +115,8 @@ void TckReader::prepareChunk(Tractogram& chunk) const {
   chunk.clear();
   chunk.per_streamline.clear();
   bool same = chunk.per_point.size() == header_.per_point.size();
-  for (size_t i = 0; same && i < chunk.per_point.size(); ++i) same = chunk.per_point[i].name == header_.per_point[i].name;
+  for (size_t i = 0; same && i < chunk.per_point.size(); ++i)
+    same = chunk.per_point[i].name == header_.per_point[i].name;
   if (!same) chunk.per_point = header_.per_point;
 }
 
@@ -143,8 +146,8 @@ bool TckReader::readStreamline(Tractogram& chunk) {
       chunk.positions.resize(3 * first_point);
       const uint64_t end = data_->end();
       if (points == 0 && data_->available() == 0)
-        warn("no terminator: file truncated at byte " + std::to_string(end) + " after " +
-             std::to_string(streamlines_) + " complete streamlines");
+        warn("no terminator: file truncated at byte " + std::to_string(end) + " after " + std::to_string(streamlines_) +
+             " complete streamlines");
       else
         warn("no terminator: file truncated at byte " + std::to_string(end) + ", last partial streamline of " +
              std::to_string(points) + " points dropped");
@@ -183,12 +186,11 @@ bool TckReader::readStreamline(Tractogram& chunk) {
     chunk.positions.resize(3 * first_point);
     if (points > 0)
       warn("streamline " + std::to_string(streamlines_) + " (" + std::to_string(points) +
-           " points) has no NaN separator before the Inf terminator at byte " + std::to_string(triplet) +
-           "; dropped");
+           " points) has no NaN separator before the Inf terminator at byte " + std::to_string(triplet) + "; dropped");
     const uint64_t after = triplet + triplet_bytes_;
     if (after < data_->end())
-      warn(std::to_string(data_->end() - after) + " bytes after the Inf terminator at byte " +
-           std::to_string(triplet) + " ignored");
+      warn(std::to_string(data_->end() - after) + " bytes after the Inf terminator at byte " + std::to_string(triplet) +
+           " ignored");
     endOfData(false);
     return false;
   }
@@ -209,10 +211,11 @@ void TckReader::endOfData(bool truncated) {
     warn("header says count " + std::to_string(header_count_) + " but" + holds);
   for (const auto& tsf : tsf_) {
     switch (tsf->end()) {
-      case TsfReader::End::kTerminated: break;
-      case TsfReader::End::kUnterminated:
-        warnFor(tsf->path(), "no terminator after its last streamline (file truncated at byte " +
-                                 std::to_string(tsf->bytesRead()) + ")");
+      case TsfReader::End::kTerminated:
+        break;
+      case TsfReader::End::kPartialSample:
+        warnFor(tsf->path(), "file ends inside a sample after its last streamline (truncated at byte " +
+                                 std::to_string(tsf->bytesRead()) + "); the stray bytes are ignored");
         break;
       case TsfReader::End::kMoreStreamlines:
         // A truncated tractogram legitimately stops short of its scalars.

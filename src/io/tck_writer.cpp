@@ -57,8 +57,8 @@ TckWriter::TckWriter(const std::string& path, const TractogramHeader& like, cons
     : path_(path) {
   const auto type = parseTckDataType(options.tck_datatype);
   if (!type)
-    fail(path, "unknown tck datatype '" + options.tck_datatype +
-                   "' (expected Float32LE, Float32BE, Float64LE or Float64BE)");
+    fail(path,
+         "unknown tck datatype '" + options.tck_datatype + "' (expected Float32LE, Float32BE, Float64LE or Float64BE)");
   type_ = *type;
 
   for (const auto& a : like.per_streamline)

@@ -42,8 +42,8 @@ void TsfReader::readStreamline(uint64_t index, size_t points, std::vector<float>
   // The values then their NaN separator, buffer by buffer.
   while (true) {
     if (data_->fill(s) < s)
-      failAt(path(), data_->end(), "file truncated inside " + indexText(index) + " after " + std::to_string(got) +
-                                       " values" + tck_side);
+      failAt(path(), data_->end(),
+             "file truncated inside " + indexText(index) + " after " + std::to_string(got) + " values" + tck_side);
     const size_t wanted = points - got + 1;
     const size_t scanned = std::min(data_->available() / s, wanted);
     const size_t hit = findNonFinite(data_->data(), scanned, type);
@@ -72,9 +72,10 @@ void TsfReader::readStreamline(uint64_t index, size_t points, std::vector<float>
 }
 
 TsfReader::End TsfReader::end() {
-  if (data_->fill(info_.datatype.bytes) < info_.datatype.bytes) return End::kUnterminated;
-  return classifySample(data_->data(), info_.datatype) == SampleKind::kInf ? End::kTerminated
-                                                                           : End::kMoreStreamlines;
+  const size_t left = data_->fill(info_.datatype.bytes);
+  if (left == 0) return End::kTerminated;
+  if (left < info_.datatype.bytes) return End::kPartialSample;
+  return classifySample(data_->data(), info_.datatype) == SampleKind::kInf ? End::kTerminated : End::kMoreStreamlines;
 }
 
 size_t firstNonFinite(const float* values, size_t n) {
@@ -130,8 +131,8 @@ void writeTsf(const std::string& path, const Tractogram& tractogram, const std::
     fail(path, "per-point array '" + array_name + "' has " + std::to_string(array->components) +
                    " components; a .tsf holds one value per point");
   if (array->values.size() != tractogram.pointCount())
-    fail(path, "per-point array '" + array_name + "' has " + std::to_string(array->values.size()) +
-                   " values for " + std::to_string(tractogram.pointCount()) + " points");
+    fail(path, "per-point array '" + array_name + "' has " + std::to_string(array->values.size()) + " values for " +
+                   std::to_string(tractogram.pointCount()) + " points");
   TsfWriter writer(path, like.properties, *type, options.overwrite);
   for (size_t i = 0; i < tractogram.streamlineCount(); ++i)
     writer.append(array->values.data() + tractogram.offsets[i], tractogram.pointsIn(i));

@@ -2,7 +2,7 @@
 //
 // Same header and datatypes as .tck (io/tck_format.h) with the first line
 // "mrtrix track scalars"; the samples are single values, a NaN after each
-// streamline and an Inf at the end. A .tsf means nothing without its .tck:
+// streamline and an Inf at the end (which MRtrix's own tcksample leaves out). A .tsf means nothing without its .tck:
 // its streamlines and points must match the tractogram one for one, so NaN
 // and Inf can never be stored as values.
 //
@@ -43,9 +43,10 @@ class TsfReader {
   // the tractogram, to `values`.
   void readStreamline(uint64_t index, size_t points, std::vector<float>& values);
 
-  enum class End { kTerminated, kUnterminated, kMoreStreamlines };
-  // What follows the streamlines read so far: the Inf terminator, nothing
-  // (a truncated file), or more streamlines than the tractogram has.
+  enum class End { kTerminated, kPartialSample, kMoreStreamlines };
+  // What follows the streamlines read so far: the Inf terminator or the end
+  // of the file (MRtrix 3.0 tcksample writes no terminator), part of a
+  // sample (a cut file), or more streamlines than the tractogram has.
   End end();
 
   // Bytes consumed so far (the position of the next sample).
