@@ -26,13 +26,13 @@ fibscope=build/fibscope
 seeds=build-fuzz/seeds
 rm -rf "$seeds"; mkdir -p "$seeds"/{tck,trk,trx,vtk}
 for fmt in tck trk trx; do
-  "$fibscope" phantom "$seeds/$fmt/phantom.$fmt" -n 3 --step 8 --min-length 20 --max-length 40 --force >/dev/null
+  "$fibscope" phantom "$seeds/$fmt/phantom.$fmt" -n 3 --step 8 --min-length 20 --max-length 40 --force >/dev/null 2>&1
 done
 printf '# vtk DataFile Version 3.0\nseed\nASCII\nDATASET POLYDATA\nPOINTS 4 float\n0 0 0 1 0 0 2 1 0 3 1 1\nLINES 2 6\n2 0 1\n2 2 3\n' \
   > "$seeds/vtk/lines.vtk"
 for script in fuzz/seeds/*; do
   [ -f "$script" ] || continue
-  fmt=$(basename "$script"); fmt=${fmt%%.*}
+  fmt=$(basename "$script"); fmt=${fmt%%.*}; fmt=${fmt%%_*}   # fuzz/seeds/<format>[_what].{py,sh}
   mkdir -p "$seeds/$fmt"
   case "$script" in
     *.py) /usr/bin/python3 "$script" "$seeds/$fmt" ;;
@@ -41,7 +41,9 @@ for script in fuzz/seeds/*; do
 done
 
 status=0
-for target in build-fuzz/fuzz_*; do
+targets=(build-fuzz/fuzz/fuzz_*)
+[ -x "${targets[0]}" ] || { echo "fuzz: no fuzz targets were built" >&2; exit 1; }
+for target in "${targets[@]}"; do
   [ -x "$target" ] || continue
   name=$(basename "$target"); fmt=${name#fuzz_}
   corpus=build-fuzz/corpus/$fmt
