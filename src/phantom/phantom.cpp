@@ -204,6 +204,7 @@ PhantomBundle PhantomGenerator::generate(uint64_t index, std::vector<float>& xyz
     if (rng.next() & 1) std::reverse(buffers.controls.begin(), buffers.controls.end());
     buildGuide(buffers.controls, kGuideSpacingMm, buffers.guide);
 
+    if (buffers.guide.tangents.empty()) continue;  // degenerate guide (a point): cannot be walked
     const double guide_length = buffers.guide.length();
     double span = guide_length, start = 0;
     if (rng.uniform() >= fullSpanProbability(bundle)) {

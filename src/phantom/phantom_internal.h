@@ -157,11 +157,12 @@ struct TrackerParameters {
   double sin_max_turn = 0.0;
 };
 
-// Tracks from arc length `start_arc` of `guide` for at most `steps` steps,
-// appending the points (x, y, z floats) to `xyz`. Every step is exactly
-// params.step long measured between the stored float points (to float
-// precision), turns by at most the parameters' maximum turn, and the walk
-// stops before the first point that would leave the phantom's ellipsoid.
+// Tracks from arc length `start_arc` of `guide` (which must have at least
+// one segment) for at most `steps` steps, appending the points (x, y, z
+// floats) to `xyz`. Every step is exactly params.step long measured between
+// the stored float points (to float precision), turns by at most the
+// parameters' maximum turn, and the walk stops before the first point that
+// would leave the phantom's ellipsoid.
 // Returns the number of points appended: 0 when the start is outside.
 size_t trackAlongGuide(const Guide& guide, double start_arc, size_t steps, const TrackerParameters& params, Rng& rng,
                        std::vector<float>& xyz);
