@@ -271,6 +271,7 @@ void appendSamples(const uint8_t* p, size_t n, const TckDataType& type, std::vec
 }
 
 void encodeSamples(const float* values, size_t n, const TckDataType& type, std::vector<uint8_t>& out) {
+  if (n == 0) return;  // `values` may be null for an empty streamline
   const size_t old = out.size();
   out.resize(old + n * type.bytes);
   uint8_t* dst = out.data() + old;
