@@ -27,7 +27,8 @@ TempDir::~TempDir() {
 
 CommandResult runCommand(const std::string& command_line) {
   CommandResult r;
-  FILE* pipe = ::popen((command_line + " 2>&1").c_str(), "r");
+  // Grouped so that redirections inside `command_line` still apply.
+  FILE* pipe = ::popen(("{ " + command_line + "\n} 2>&1").c_str(), "r");
   if (!pipe) return r;
   char buf[4096];
   size_t n;
