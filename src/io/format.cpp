@@ -19,6 +19,22 @@ std::string extensionOf(const std::string& path) {
 
 }  // namespace
 
+void TractogramReader::startChunk(Tractogram& chunk) const {
+  auto follow = [](std::vector<DataArray>& arrays, const std::vector<DataArray>& declared) {
+    bool same = arrays.size() == declared.size();
+    for (size_t i = 0; same && i < arrays.size(); ++i)
+      same = arrays[i].name == declared[i].name && arrays[i].components == declared[i].components &&
+             arrays[i].dtype == declared[i].dtype;
+    if (!same) {
+      arrays.clear();
+      for (const auto& a : declared) arrays.push_back({a.name, a.components, a.dtype, {}});
+    }
+  };
+  follow(chunk.per_streamline, header_.per_streamline);
+  follow(chunk.per_point, header_.per_point);
+  chunk.clear();
+}
+
 std::unique_ptr<TractogramReader> openTractogram(const std::string& path) {
   const std::string ext = extensionOf(path);
   if (ext == ".tck") return openTck(path);

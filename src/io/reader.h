@@ -36,6 +36,9 @@ class TractogramReader {
 
  protected:
   void warn(const std::string& message) { warnings_.push_back(header_.path + ": " + message); }
+  // Empties `chunk` for the next read(): its data arrays follow the header's
+  // (names, components, dtypes), keeping their capacity when they already do.
+  void startChunk(Tractogram& chunk) const;
   TractogramHeader header_;
   std::vector<std::string> warnings_;
 };

@@ -50,7 +50,6 @@ class TckReader final : public TractogramReader {
   bool fillTriplet() { return data_->fill(triplet_bytes_) >= triplet_bytes_; }
   // Ends reading: the warning for a truncated file, then the count and tsf checks.
   void endOfData(bool truncated);
-  void prepareChunk(Tractogram& chunk) const;
   void warnFor(const std::string& path, const std::string& message) { warnings_.push_back(path + ": " + message); }
 
   std::unique_ptr<TrackDataStream> data_;
@@ -111,17 +110,8 @@ TckReader::TckReader(const std::string& path, const std::vector<std::string>& ts
   }
 }
 
-void TckReader::prepareChunk(Tractogram& chunk) const {
-  chunk.clear();
-  chunk.per_streamline.clear();
-  bool same = chunk.per_point.size() == header_.per_point.size();
-  for (size_t i = 0; same && i < chunk.per_point.size(); ++i)
-    same = chunk.per_point[i].name == header_.per_point[i].name;
-  if (!same) chunk.per_point = header_.per_point;
-}
-
 bool TckReader::read(Tractogram& chunk, size_t max_points) {
-  prepareChunk(chunk);
+  startChunk(chunk);
   if (at_end_) return false;
   max_points = std::max<size_t>(max_points, 1);
   // Bounded by what the file can still hold, so a lying file cannot make us allocate.

@@ -34,7 +34,6 @@ class TrkReader final : public TractogramReader {
   uint64_t bytesRead() const override { return pos_; }
 
  private:
-  void prepareChunk(Tractogram& chunk) const;
   void decodeStreamline(Tractogram& chunk, uint32_t m, uint64_t at) const;
   [[noreturn]] void reportNonFinite(uint32_t m, uint64_t at) const;
   void finishFile();
@@ -85,20 +84,8 @@ TrkReader::TrkReader(const std::string& path) : file_(path) {
   file_.adviseSequential();
 }
 
-void TrkReader::prepareChunk(Tractogram& chunk) const {
-  auto matches = [](const std::vector<DataArray>& have, const std::vector<DataArray>& want) {
-    if (have.size() != want.size()) return false;
-    for (size_t i = 0; i < have.size(); ++i)
-      if (have[i].name != want[i].name || have[i].components != want[i].components) return false;
-    return true;
-  };
-  if (!matches(chunk.per_point, header_.per_point)) chunk.per_point = header_.per_point;
-  if (!matches(chunk.per_streamline, header_.per_streamline)) chunk.per_streamline = header_.per_streamline;
-  chunk.clear();
-}
-
 bool TrkReader::read(Tractogram& chunk, size_t max_points) {
-  prepareChunk(chunk);
+  startChunk(chunk);
   if (done_) return false;
   const uint8_t* data = file_.data();
   const uint64_t size = file_.size();

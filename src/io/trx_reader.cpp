@@ -432,16 +432,7 @@ void TrxReader::appendValues(ArrayStream& stream, uint64_t count, std::vector<fl
 }
 
 bool TrxReader::read(Tractogram& chunk, size_t max_points) {
-  chunk.clear();
-  auto follow = [](std::vector<DataArray>& arrays, const std::vector<DataArray>& declared) {
-    bool same = arrays.size() == declared.size();
-    for (size_t i = 0; same && i < arrays.size(); ++i)
-      same = arrays[i].name == declared[i].name && arrays[i].components == declared[i].components &&
-             arrays[i].dtype == declared[i].dtype;
-    if (!same) arrays = declared;
-  };
-  follow(chunk.per_streamline, header_.per_streamline);
-  follow(chunk.per_point, header_.per_point);
+  startChunk(chunk);
   if (next_streamline_ >= nb_streamlines_) return false;
 
   // Whole streamlines up to max_points points (and at most max_points

@@ -767,15 +767,7 @@ void VtkReader::skipMetadata(VtkCursor& c) {
 }
 
 bool VtkReader::read(Tractogram& chunk, size_t max_points) {
-  auto matches = [](const std::vector<DataArray>& have, const std::vector<DataArray>& want) {
-    if (have.size() != want.size()) return false;
-    for (size_t i = 0; i < have.size(); ++i)
-      if (have[i].name != want[i].name || have[i].components != want[i].components) return false;
-    return true;
-  };
-  if (!matches(chunk.per_point, header_.per_point)) chunk.per_point = header_.per_point;
-  if (!matches(chunk.per_streamline, header_.per_streamline)) chunk.per_streamline = header_.per_streamline;
-  chunk.clear();
+  startChunk(chunk);
   const uint64_t lines = lines_.cellCount();
   if (next_line_ >= lines) return false;
   while (next_line_ < lines) {
