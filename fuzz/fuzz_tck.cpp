@@ -17,6 +17,7 @@
 #include "core/error.h"
 #include "io/reader.h"
 #include "io/writer.h"
+#include "fuzz_support.h"
 
 namespace {
 
@@ -29,18 +30,10 @@ struct Paths {
 
 const Paths& paths() {
   static const Paths p = [] {
-    // Memory-backed /dev/shm when there is one: rewriting a file in place on
-    // ext4 flushes it on close, which would cap the fuzzer at ~100 runs/s.
-    const char* tmp = std::getenv("TMPDIR");
-    struct stat st {};
-    const std::string dir = ::stat("/dev/shm", &st) == 0 && S_ISDIR(st.st_mode) ? "/dev/shm"
-                            : tmp && *tmp                                       ? tmp
-                                                                                : "/tmp";
-    const std::string prefix = dir + "/fuzz_tck." + std::to_string(::getpid()) + ".";
     Paths q;
-    q.tck = prefix + "input.tck";
-    q.tsf = prefix + "input.tsf";
-    q.reference = prefix + "reference.tck";
+    q.tck = fibscope::fuzz::scratchPath("tck", "input.tck");
+    q.tsf = fibscope::fuzz::scratchPath("tck", "input.tsf");
+    q.reference = fibscope::fuzz::scratchPath("tck", "reference.tck");
     fibscope::Tractogram t;
     const float xyz[9] = {1, 2, 3, 4, 5, 6, 7, 8, 9};
     t.addStreamline(xyz, 2);
@@ -61,23 +54,16 @@ const Paths& paths() {
   return p;
 }
 
-void writeFile(const std::string& path, const uint8_t* data, size_t size) {
-  FILE* f = std::fopen(path.c_str(), "wb");
-  if (!f) std::abort();
-  if (size && std::fwrite(data, 1, size, f) != size) std::abort();
-  std::fclose(f);
-}
-
 void readAll(const std::string& tck, const std::vector<std::string>& tsf) {
   try {
     auto reader = fibscope::openTck(tck, tsf);
     fibscope::Tractogram chunk;
     while (reader->read(chunk, 16)) {
-      if (!chunk.validate().empty() || chunk.streamlineCount() == 0) std::abort();
-      if (reader->bytesRead() > reader->header().file_bytes) std::abort();
+      fibscope::fuzz::checkChunk(*reader, chunk);
+      if (chunk.streamlineCount() == 0) std::abort();
     }
   } catch (const fibscope::Error& e) {
-    if (std::string(e.what()).find('\n') != std::string::npos) std::abort();  // messages are one line
+    fibscope::fuzz::checkMessage(e);
   }
 }
 
@@ -85,10 +71,10 @@ void readAll(const std::string& tck, const std::vector<std::string>& tsf) {
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const Paths& p = paths();
-  writeFile(p.tck, data, size);
+  fibscope::fuzz::writeInput(p.tck, data, size);
   readAll(p.tck, {});
-  writeFile(p.tsf, data, size);
-  writeFile(p.reference, reinterpret_cast<const uint8_t*>(p.reference_bytes.data()), p.reference_bytes.size());
+  fibscope::fuzz::writeInput(p.tsf, data, size);
+  fibscope::fuzz::writeInput(p.reference, reinterpret_cast<const uint8_t*>(p.reference_bytes.data()), p.reference_bytes.size());
   readAll(p.reference, {p.tsf});
   for (const auto* f : {&p.tck, &p.tsf, &p.reference}) std::remove(f->c_str());
   return 0;

@@ -15,6 +15,7 @@
 
 #include "core/error.h"
 #include "io/reader.h"
+#include "fuzz_support.h"
 #include "io/writer.h"
 
 namespace {
@@ -25,27 +26,10 @@ struct Paths {
 
 const Paths& paths() {
   static const Paths p = [] {
-    // /dev/shm when there is one: rewriting files on ext4 caps the run rate.
-    const char* tmp = std::getenv("TMPDIR");
-    struct stat st {};
-    const std::string dir =
-        ::stat("/dev/shm", &st) == 0 && S_ISDIR(st.st_mode) ? "/dev/shm" : tmp && *tmp ? tmp : "/tmp";
-    const std::string prefix = dir + "/fuzz_trk." + std::to_string(::getpid()) + ".";
-    return Paths{prefix + "input.trk", prefix + "padded.trk", prefix + "output.trk"};
+    auto prefix = [](const std::string& name) { return fibscope::fuzz::scratchPath("trk", name); };
+    return Paths{prefix("input.trk"), prefix("padded.trk"), prefix("output.trk")};
   }();
   return p;
-}
-
-void writeFile(const std::string& path, const uint8_t* data, size_t size, size_t padded_size) {
-  FILE* f = std::fopen(path.c_str(), "wb");
-  if (!f) std::abort();
-  if (size && std::fwrite(data, 1, size, f) != size) std::abort();
-  for (size_t i = size; i < padded_size; ++i) std::fputc(0, f);
-  std::fclose(f);
-}
-
-void checkMessage(const fibscope::Error& e) {
-  if (std::string(e.what()).find('\n') != std::string::npos) std::abort();  // messages are one line
 }
 
 // Reads the whole file; returns false on Error.
@@ -61,7 +45,7 @@ bool readAll(const std::string& path, fibscope::Tractogram* all, fibscope::Tract
     if (header) *header = reader->header();
     return true;
   } catch (const fibscope::Error& e) {
-    checkMessage(e);
+    fibscope::fuzz::checkMessage(e);
     return false;
   }
 }
@@ -70,13 +54,13 @@ bool readAll(const std::string& path, fibscope::Tractogram* all, fibscope::Tract
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const Paths& p = paths();
-  writeFile(p.input, data, size, size);
+  fibscope::fuzz::writeInput(p.input, data, size, size);
   fibscope::Tractogram all;
   fibscope::TractogramHeader header;
   const bool ok = readAll(p.input, &all, &header);
   const size_t page = static_cast<size_t>(::sysconf(_SC_PAGESIZE));
   if (size % page != 0) {
-    writeFile(p.padded, data, size, (size / page + 1) * page);
+    fibscope::fuzz::writeInput(p.padded, data, size, (size / page + 1) * page);
     readAll(p.padded, nullptr, nullptr);
   }
   if (ok) {
@@ -90,7 +74,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
           back.per_streamline.size() != all.per_streamline.size())
         std::abort();
     } catch (const fibscope::Error& e) {
-      checkMessage(e);  // e.g. a point outside the float range of the grid
+      fibscope::fuzz::checkMessage(e);  // e.g. a point outside the float range of the grid
     }
   }
   for (const auto* f : {&p.input, &p.padded, &p.output}) std::remove(f->c_str());

@@ -13,36 +13,17 @@
 
 #include "core/error.h"
 #include "io/reader.h"
-
-namespace {
-
-// One input file path per process, reused for every input (the file is
-// removed after each input: libFuzzer may end with _Exit, skipping atexit).
-const std::string& inputPath() {
-  static const std::string path = [] {
-    const char* dir = std::getenv("TMPDIR");
-    return std::string(dir && *dir ? dir : "/tmp") + "/fuzz_trx_" + std::to_string(::getpid()) + ".trx";
-  }();
-  return path;
-}
-
-}  // namespace
+#include "fuzz_support.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  const std::string& path = inputPath();
-  FILE* file = std::fopen(path.c_str(), "wb");
-  if (!file) std::abort();
-  if (size > 0 && std::fwrite(data, 1, size, file) != size) std::abort();
-  std::fclose(file);
+  static const std::string path = fibscope::fuzz::scratchPath("trx", "input.trx");
+  fibscope::fuzz::writeInput(path, data, size);
   try {
     auto reader = fibscope::openTrx(path);
     fibscope::Tractogram chunk;
-    while (reader->read(chunk, 16)) {
-      if (!chunk.validate().empty()) std::abort();
-    }
-    if (reader->bytesRead() > reader->header().file_bytes) std::abort();
+    while (reader->read(chunk, 16)) fibscope::fuzz::checkChunk(*reader, chunk);
   } catch (const fibscope::Error& e) {
-    if (std::string(e.what()).find('\n') != std::string::npos) std::abort();
+    fibscope::fuzz::checkMessage(e);
   }
   ::unlink(path.c_str());
   return 0;
