@@ -1,0 +1,47 @@
+// Error statistics of the fiblet codec: every point decoded (as the GPU
+// decodes it, by the log-step scan) and compared with the original point in
+// world space. Figures in micrometres (DESIGN.md section 4).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "codec/codec_params.h"
+#include "codec/fiblet_decoder.h"
+#include "core/tractogram.h"
+
+namespace fibscope {
+
+struct CodecErrorStats {
+  uint64_t points = 0;
+  double max_um = 0;
+  double mean_um = 0;
+  double rms_um = 0;
+  double p99_um = 0;  // from a 0.01 um histogram (exact to 0.01 um below 1 mm)
+};
+
+// Accumulates point distances in bounded memory (a fixed histogram), so
+// error statistics of any size of tractogram can be streamed.
+class CodecErrorMeter {
+ public:
+  CodecErrorMeter();
+  void add(double distance_um);
+  CodecErrorStats stats() const;
+
+ private:
+  static constexpr double kBinUm = 0.01;
+  static constexpr size_t kBins = 100000;  // up to 1 mm; beyond goes to the last bin
+  std::vector<uint64_t> histogram_;
+  uint64_t points_ = 0;
+  double sum_ = 0, sum2_ = 0, max_ = 0;
+};
+
+// Decodes `fiblets` and measures each point against `original` (same
+// streamlines, same order, same point counts). `per_point_um`, when given,
+// receives the distance of every point. Throws Error("fiblets: ...") when the
+// fiblets are inconsistent or do not match the original's point counts.
+CodecErrorStats measureCodecError(const Tractogram& original, const EncodedFiblets& fiblets,
+                                  const FibletDecoder& decoder, std::vector<float>* per_point_um = nullptr);
+
+}  // namespace fibscope

@@ -1,0 +1,235 @@
+#include "codec/fiblet_encoder.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "core/error.h"
+
+namespace fibscope {
+
+using shader::FibletTransform;
+using shader::vec3;
+
+uint32_t encodeDirection(const double direction[3], double alpha) {
+  const double norm =
+      std::sqrt(direction[0] * direction[0] + direction[1] * direction[1] + direction[2] * direction[2]);
+  double x = 0, y = 0, z = 1;
+  if (norm > 0) {
+    x = direction[0] / norm;
+    y = direction[1] / norm;
+    z = direction[2] / norm;
+  }
+  const double theta = std::min(std::acos(std::clamp(z, -1.0, 1.0)), alpha);
+  const double phi = std::atan2(y, x);
+  const double theta_h = theta * (std::numbers::pi / 2) / alpha;
+  const double hx = std::sin(theta_h) * std::cos(phi), hy = std::sin(theta_h) * std::sin(phi);
+  const double hz = std::cos(theta_h);
+  // Onto the octahedron |x| + |y| + z = 1, then the 45-degree rotation that
+  // turns its upper half into the square [-1, 1]^2 (see fibletOctahedralCell).
+  const double s = std::fabs(hx) + std::fabs(hy) + std::max(hz, 0.0);
+  const double ox = hx / s, oy = hy / s;
+  const double u = ox + oy, v = ox - oy;
+  const auto cell = [](double c) {
+    return uint32_t(std::clamp(std::floor((c + 1.0) * 8.0), 0.0, double(shader::kFibletGridSize - 1)));
+  };
+  return cell(u) << 4 | cell(v);
+}
+
+FibletEncoder::FibletEncoder(const CodecParams& params, const EncodeOptions& options)
+    : params_(params), options_(options), decoder_(params) {
+  if (options.search_radius < 0 || options.search_radius > 15) fail("fiblet encoder", "search radius outside [0, 15]");
+}
+
+namespace {
+
+double dot3(const vec3& a, const double b[3]) { return double(a.x) * b[0] + double(a.y) * b[1] + double(a.z) * b[2]; }
+
+vec3 toVec3(const double* p) { return vec3(float(p[0]), float(p[1]), float(p[2])); }
+
+}  // namespace
+
+size_t FibletEncoder::encodeFiblet(size_t first, size_t n, bool begins, EncodedFiblets& out) {
+  const uint32_t big_n = params_.points_per_fiblet;
+  const size_t base = out.bytes.size();
+  out.bytes.resize(base + params_.recordBytes(), 0);
+  const double* t = target_.data();
+
+  // Points 0 and 1, quantised to 16 bits per coordinate.
+  vec3 decoded[2];
+  for (int which = 0; which < 2; ++which) {
+    const size_t index = std::min(first + size_t(which), n - 1);
+    float c[3];
+    for (int axis = 0; axis < 3; ++axis) {
+      const double scaled = t[3 * index + axis] * shader::kFibletQuantMax;
+      if (which == 0 && !(scaled >= -0.5 && scaled <= shader::kFibletQuantMax + 0.5)) ++report_.clamped_points;
+      const auto q = uint32_t(std::clamp(std::nearbyint(scaled), 0.0, double(shader::kFibletQuantMax)));
+      out.bytes[base + 6 * size_t(which) + 2 * size_t(axis)] = uint8_t(q);
+      out.bytes[base + 6 * size_t(which) + 2 * size_t(axis) + 1] = uint8_t(q >> 8);
+      c[axis] = shader::fibletDequantize(q);
+    }
+    decoded[which] = vec3(c[0], c[1], c[2]);
+  }
+
+  const size_t count_max = std::min<size_t>(big_n, n - first);
+  size_t count = std::min<size_t>(count_max, 2);
+  if (count_max >= 3) {
+    const vec3 v(params_.v[0], params_.v[1], params_.v[2]);
+    const double delta = params_.delta;
+    const double alpha = params_.alpha;
+    const double cos_alpha = std::cos(alpha);
+    const double max_error2 = std::pow(options_.max_point_error * delta, 2);
+    const bool closed = options_.mode == EncodeMode::ClosedLoop;
+    const int radius = options_.search_radius;
+    // The decoder's frame, and (open loop) the frame of the true directions.
+    FibletTransform w = shader::fibletInitialTransform(decoded[0], decoded[1], v);
+    FibletTransform truth = shader::fibletInitialTransform(toVec3(t + 3 * first), toVec3(t + 3 * first + 3), v);
+    for (size_t k = 2; k < count_max; ++k) {
+      const size_t g = first + k;
+      const double seg[3] = {t[3 * g] - t[3 * g - 3], t[3 * g + 1] - t[3 * g - 2], t[3 * g + 2] - t[3 * g - 1]};
+      const double prev[3] = {t[3 * g - 3] - t[3 * g - 6], t[3 * g - 2] - t[3 * g - 5], t[3 * g - 1] - t[3 * g - 4]};
+      const double len = std::sqrt(seg[0] * seg[0] + seg[1] * seg[1] + seg[2] * seg[2]);
+      const double plen = std::sqrt(prev[0] * prev[0] + prev[1] * prev[1] + prev[2] * prev[2]);
+      if (std::fabs(len - delta) > options_.step_tolerance * delta) {
+        ++report_.step_splits;
+        break;
+      }
+      // Compare cosines with a little slack so that a turn of exactly alpha
+      // (the largest representable one) is not an exception.
+      const double cos_turn = plen > 0 ? (seg[0] * prev[0] + seg[1] * prev[1] + seg[2] * prev[2]) / (len * plen) : -1.0;
+      if (cos_turn < cos_alpha - 1e-6) {
+        ++report_.angle_splits;
+        break;
+      }
+      uint32_t code = 0;
+      if (closed) {
+        const double goal[3] = {t[3 * g], t[3 * g + 1], t[3 * g + 2]};
+        const double diff[3] = {goal[0] - w.t.x, goal[1] - w.t.y, goal[2] - w.t.z};
+        const double local[3] = {dot3(w.c0, diff), dot3(w.c1, diff), dot3(w.c2, diff)};
+        const uint32_t centre = encodeDirection(local, alpha);
+        const int ci = int(centre >> 4), cj = int(centre & 15u);
+        double best = std::numeric_limits<double>::infinity();
+        for (int i = std::max(ci - radius, 0); i <= std::min(ci + radius, 15); ++i) {
+          for (int j = std::max(cj - radius, 0); j <= std::min(cj + radius, 15); ++j) {
+            const auto candidate = uint32_t(i << 4 | j);
+            // Exactly the translation fibletCompose(w, L) computes.
+            const vec3 p = shader::fibletRotate(w, decoder_.localTransform(candidate).t) + w.t;
+            const double e[3] = {double(p.x) - goal[0], double(p.y) - goal[1], double(p.z) - goal[2]};
+            const double e2 = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
+            if (e2 < best) {
+              best = e2;
+              code = candidate;
+            }
+          }
+        }
+        if (best > max_error2) {
+          ++report_.error_splits;
+          break;
+        }
+      } else {
+        const double local[3] = {dot3(truth.c0, seg), dot3(truth.c1, seg), dot3(truth.c2, seg)};
+        code = encodeDirection(local, alpha);
+        const vec3 exact = toVec3(local) * float(1.0 / len);
+        truth = shader::fibletCompose(truth, shader::fibletLocalTransform(exact, v, params_.delta));
+      }
+      w = shader::fibletCompose(w, decoder_.localTransform(code));
+      out.bytes[base + shader::fibletCodeByte(uint32_t(k))] = uint8_t(code);
+      count = k + 1;
+    }
+  }
+  const bool ends = first + count == n;
+  out.bytes[base + shader::fibletFlagsByte(big_n)] = uint8_t(shader::fibletFlags(begins, ends, uint32_t(count)));
+  ++report_.fiblets;
+  return count;
+}
+
+void FibletEncoder::encodeStreamline(const float* xyz, size_t n, EncodedFiblets& out) {
+  if (out.record_bytes == 0) out.record_bytes = params_.recordBytes();
+  if (out.record_bytes != params_.recordBytes()) fail("fiblet encoder", "output holds records of another size");
+  const uint64_t first_fiblet = out.fiblet_base + out.fibletCount();
+  if (first_fiblet + (n + 1) > std::numeric_limits<uint32_t>::max() || n > std::numeric_limits<uint32_t>::max())
+    fail("fiblet encoder", "more than 2^32 fiblets or points in one fiber");
+  out.fiber_first_fiblet.push_back(uint32_t(first_fiblet));
+  out.fiber_points.push_back(uint32_t(n));
+  ++report_.fibers;
+  report_.points += n;
+  if (n == 1) ++report_.single_point_fibers;
+  if (n == 2) ++report_.two_point_fibers;
+
+  target_.resize(3 * n);
+  for (size_t i = 0; i < 3 * n; ++i)
+    target_[i] = (double(xyz[i]) - double(params_.translation[i % 3])) * double(params_.scale);
+  for (size_t first = 0; first < n;) first += encodeFiblet(first, n, first == 0, out);
+}
+
+void FibletEncoder::encode(const Tractogram& chunk, EncodedFiblets& out) {
+  for (size_t s = 0; s < chunk.streamlineCount(); ++s)
+    encodeStreamline(chunk.point(chunk.offsets[s]), chunk.pointsIn(s), out);
+}
+
+EncodedFiblets encodeTractogram(const Tractogram& tractogram, const CodecParams& params, const EncodeOptions& options,
+                                EncodeReport* report) {
+  FibletEncoder encoder(params, options);
+  EncodedFiblets out;
+  out.record_bytes = params.recordBytes();
+  out.bytes.reserve(size_t(double(tractogram.pointCount()) / params.points_per_fiblet * 1.05 + 16) *
+                    params.recordBytes());
+  encoder.encode(tractogram, out);
+  if (report) *report = encoder.report();
+  return out;
+}
+
+Tractogram resampleToStep(const Tractogram& in, double step_mm, ResampleReport* report) {
+  if (!(step_mm > 0) || !std::isfinite(step_mm)) fail("resample", "step must be finite and > 0");
+  Tractogram out;
+  out.per_streamline = in.per_streamline;
+  ResampleReport counts;
+  counts.input_points = in.pointCount();
+  const double step2 = step_mm * step_mm;
+  for (size_t s = 0; s < in.streamlineCount(); ++s) {
+    const float* p = in.point(in.offsets[s]);
+    const size_t n = in.pointsIn(s);
+    if (n > 0) out.positions.insert(out.positions.end(), p, p + 3);
+    if (n >= 2) {
+      double cur[3] = {p[0], p[1], p[2]};
+      size_t seg = 0;  // the position is on segment seg (points seg, seg + 1) at parameter u
+      double u = 0;
+      while (seg + 1 < n) {
+        const float* a = p + 3 * seg;
+        const float* b = a + 3;
+        const double bc[3] = {b[0] - cur[0], b[1] - cur[1], b[2] - cur[2]};
+        if (bc[0] * bc[0] + bc[1] * bc[1] + bc[2] * bc[2] < step2) {
+          ++seg;
+          u = 0;
+          continue;
+        }
+        // |a + x d - cur| = step has its larger root in [u, 1]: |a + u d -
+        // cur| <= step (cur itself or a vertex inside the sphere) and
+        // |b - cur| >= step.
+        const double d[3] = {double(b[0]) - a[0], double(b[1]) - a[1], double(b[2]) - a[2]};
+        const double e[3] = {a[0] - cur[0], a[1] - cur[1], a[2] - cur[2]};
+        const double qa = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+        const double qb = 2 * (d[0] * e[0] + d[1] * e[1] + d[2] * e[2]);
+        const double qc = e[0] * e[0] + e[1] * e[1] + e[2] * e[2] - step2;
+        const double root = (-qb + std::sqrt(std::max(qb * qb - 4 * qa * qc, 0.0))) / (2 * qa);
+        u = std::clamp(root, u, 1.0);
+        for (int c = 0; c < 3; ++c) {
+          cur[c] = a[c] + u * d[c];
+          out.positions.push_back(float(cur[c]));
+        }
+        ++counts.moved_points;
+      }
+      const float* last = p + 3 * (n - 1);
+      const double gap2 = (last[0] - cur[0]) * (last[0] - cur[0]) + (last[1] - cur[1]) * (last[1] - cur[1]) +
+                          (last[2] - cur[2]) * (last[2] - cur[2]);
+      if (gap2 > 0) out.positions.insert(out.positions.end(), last, last + 3);
+    }
+    out.offsets.push_back(out.positions.size() / 3);
+  }
+  counts.output_points = out.pointCount();
+  if (report) *report = counts;
+  return out;
+}
+
+}  // namespace fibscope

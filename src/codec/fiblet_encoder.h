@@ -1,0 +1,105 @@
+// Fiblet encoder (DESIGN.md section 5): streamlines in world mm -> fixed-size
+// fiblet records and per-fiber tables, in the paper's open-loop mode or the
+// closed-loop mode that runs the decoder alongside.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "codec/codec_params.h"
+#include "codec/fiblet_decoder.h"
+#include "core/tractogram.h"
+
+namespace fibscope {
+
+enum class EncodeMode : uint8_t {
+  // Paper section 3.2: each true direction, in the frame propagated from the
+  // previous true direction, is quantised to the nearest code; the decoded
+  // path drifts as quantisation errors accumulate.
+  OpenLoop,
+  // At each point, the code among the (2r+1)^2 cells around the open-loop
+  // one whose decoded point lands nearest the original point; the target
+  // direction is taken from the decoded frame, so errors do not accumulate.
+  ClosedLoop,
+};
+
+struct EncodeOptions {
+  EncodeMode mode = EncodeMode::ClosedLoop;
+  int search_radius = 2;  // closed loop: cells searched each side of the open-loop cell (2 = 5x5)
+  // A segment whose length differs from delta by more than this fraction of
+  // delta starts a new fiblet (the segment becomes the join between two
+  // fiblets, which stores both its ends exactly).
+  double step_tolerance = 0.05;
+  // Closed loop only: a point that would decode farther than this many
+  // deltas from the original starts a new fiblet instead (rare: it happens
+  // when the decoded frame has lagged behind a sharp run of turns).
+  double max_point_error = 0.15;
+};
+
+// What the encoder did, summed over everything encoded so far.
+struct EncodeReport {
+  uint64_t fibers = 0;
+  uint64_t points = 0;
+  uint64_t fiblets = 0;
+  uint64_t angle_splits = 0;  // turns above alpha
+  uint64_t step_splits = 0;   // steps off delta by more than the tolerance
+  uint64_t error_splits = 0;  // closed-loop points that would exceed max_point_error
+  uint64_t single_point_fibers = 0;
+  uint64_t two_point_fibers = 0;
+  uint64_t clamped_points = 0;  // outside the normalisation box (clamped to [0,1]^3)
+
+  uint64_t splits() const { return angle_splits + step_splits + error_splits; }
+};
+
+// The nearest code to a local direction (unit, +z forward): the direction
+// is clamped into the alpha-cap, mapped uniformly to the hemisphere
+// (theta' = theta * (pi/2) / alpha) and quantised on the 16 x 16 half-
+// octahedron grid. The inverse of decodeDirection on cell centres.
+uint32_t encodeDirection(const double direction[3], double alpha);
+
+class FibletEncoder {
+ public:
+  // Throws Error when the parameters are invalid.
+  FibletEncoder(const CodecParams& params, const EncodeOptions& options = {});
+
+  // Appends the fiblets and the table entries of one streamline (n points,
+  // x,y,z interleaved, world mm) to `out`. Global fiblet indices count from
+  // out.fiblet_base; a caller that streams may write out and clear
+  // out.bytes and the tables between calls if it advances fiblet_base.
+  void encodeStreamline(const float* xyz, size_t n, EncodedFiblets& out);
+  void encode(const Tractogram& chunk, EncodedFiblets& out);
+
+  const EncodeReport& report() const { return report_; }
+  const FibletDecoder& decoder() const { return decoder_; }
+
+ private:
+  // Encodes points [first, first + count_max) or fewer (stopping at a split)
+  // as one fiblet; returns the number of points it took.
+  size_t encodeFiblet(size_t first, size_t n, bool begins, EncodedFiblets& out);
+
+  CodecParams params_;
+  EncodeOptions options_;
+  FibletDecoder decoder_;
+  EncodeReport report_;
+  std::vector<double> target_;  // the streamline in normalised space
+};
+
+// Encodes a whole tractogram; `report` (optional) receives the counts.
+EncodedFiblets encodeTractogram(const Tractogram& tractogram, const CodecParams& params,
+                                const EncodeOptions& options = {}, EncodeReport* report = nullptr);
+
+struct ResampleReport {
+  uint64_t input_points = 0;
+  uint64_t output_points = 0;
+  uint64_t moved_points = 0;  // output points that are not an input point
+};
+
+// Resamples every streamline so that consecutive points are step_mm apart
+// (chord length, the step the decoder uses): each new point is where the
+// sphere of radius step_mm around the previous one leaves the polyline. The
+// first and last input points are kept; the last segment is shorter (the
+// encoder stores it as a step exception). Per-point data arrays are dropped
+// (their samples no longer match). Throws Error when step_mm is not > 0.
+Tractogram resampleToStep(const Tractogram& tractogram, double step_mm, ResampleReport* report = nullptr);
+
+}  // namespace fibscope
