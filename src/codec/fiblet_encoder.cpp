@@ -180,12 +180,28 @@ EncodedFiblets encodeTractogram(const Tractogram& tractogram, const CodecParams&
   return out;
 }
 
+namespace {
+
+// Distance from p to the segment [a, b].
+double pointSegmentDistance(const float* p, const double a[3], const double b[3]) {
+  const double ab[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+  const double ap[3] = {p[0] - a[0], p[1] - a[1], p[2] - a[2]};
+  const double len2 = ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2];
+  const double u = len2 > 0 ? std::clamp((ab[0] * ap[0] + ab[1] * ap[1] + ab[2] * ap[2]) / len2, 0.0, 1.0) : 0.0;
+  const double d[3] = {ap[0] - u * ab[0], ap[1] - u * ab[1], ap[2] - u * ab[2]};
+  return std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+}
+
+}  // namespace
+
 Tractogram resampleToStep(const Tractogram& in, double step_mm, ResampleReport* report) {
   if (!(step_mm > 0) || !std::isfinite(step_mm)) fail("resample", "step must be finite and > 0");
   Tractogram out;
   out.per_streamline = in.per_streamline;
   ResampleReport counts;
   counts.input_points = in.pointCount();
+  double deviation_sum = 0;
+  uint64_t deviation_count = 0;
   const double step2 = step_mm * step_mm;
   for (size_t s = 0; s < in.streamlineCount(); ++s) {
     const float* p = in.point(in.offsets[s]);
@@ -193,6 +209,18 @@ Tractogram resampleToStep(const Tractogram& in, double step_mm, ResampleReport* 
     if (n > 0) out.positions.insert(out.positions.end(), p, p + 3);
     if (n >= 2) {
       double cur[3] = {p[0], p[1], p[2]};
+      // Input vertices passed since the last output point: they lie between
+      // it and the next one, and are measured against that chord.
+      size_t pending_from = 1, pending_to = 1;
+      auto measure = [&](const double from[3], const double to[3]) {
+        for (size_t i = pending_from; i < pending_to; ++i) {
+          const double dev = pointSegmentDistance(p + 3 * i, from, to);
+          deviation_sum += dev;
+          ++deviation_count;
+          counts.max_deviation_mm = std::max(counts.max_deviation_mm, dev);
+        }
+        pending_from = pending_to;
+      };
       size_t seg = 0;  // the position is on segment seg (points seg, seg + 1) at parameter u
       double u = 0;
       while (seg + 1 < n) {
@@ -202,6 +230,7 @@ Tractogram resampleToStep(const Tractogram& in, double step_mm, ResampleReport* 
         if (bc[0] * bc[0] + bc[1] * bc[1] + bc[2] * bc[2] < step2) {
           ++seg;
           u = 0;
+          pending_to = seg + 1 < n ? seg + 1 : seg;  // vertex seg passed (the last one is kept)
           continue;
         }
         // |a + x d - cur| = step has its larger root in [u, 1]: |a + u d -
@@ -214,20 +243,26 @@ Tractogram resampleToStep(const Tractogram& in, double step_mm, ResampleReport* 
         const double qc = e[0] * e[0] + e[1] * e[1] + e[2] * e[2] - step2;
         const double root = (-qb + std::sqrt(std::max(qb * qb - 4 * qa * qc, 0.0))) / (2 * qa);
         u = std::clamp(root, u, 1.0);
+        const double previous[3] = {cur[0], cur[1], cur[2]};
         for (int c = 0; c < 3; ++c) {
           cur[c] = a[c] + u * d[c];
           out.positions.push_back(float(cur[c]));
         }
+        measure(previous, cur);
         ++counts.moved_points;
       }
       const float* last = p + 3 * (n - 1);
       const double gap2 = (last[0] - cur[0]) * (last[0] - cur[0]) + (last[1] - cur[1]) * (last[1] - cur[1]) +
                           (last[2] - cur[2]) * (last[2] - cur[2]);
       if (gap2 > 0) out.positions.insert(out.positions.end(), last, last + 3);
+      const double end[3] = {last[0], last[1], last[2]};
+      measure(cur, end);
     }
     out.offsets.push_back(out.positions.size() / 3);
   }
   counts.output_points = out.pointCount();
+  // Over interior input points only: the first and last are kept exactly.
+  counts.mean_deviation_mm = deviation_count ? deviation_sum / double(deviation_count) : 0.0;
   if (report) *report = counts;
   return out;
 }

@@ -92,6 +92,10 @@ struct ResampleReport {
   uint64_t input_points = 0;
   uint64_t output_points = 0;
   uint64_t moved_points = 0;  // output points that are not an input point
+  // What the resampling cost: distance of each input point to the resampled
+  // polyline (the chord between the output points around it), in mm.
+  double max_deviation_mm = 0;
+  double mean_deviation_mm = 0;
 };
 
 // Resamples every streamline so that consecutive points are step_mm apart

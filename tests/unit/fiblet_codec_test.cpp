@@ -378,6 +378,12 @@ TEST(FibletCodec, resamplingMakesStepsConstantSoOnlyTheLastSegmentIsAnException)
   EXPECT_EQ(rr.input_points, 400u);
   EXPECT_EQ(rr.output_points, r.pointCount());
   EXPECT_GT(rr.moved_points, 100u);
+  // The helix has radius 5 mm: a 0.1 mm chord is at most 0.1^2 / (8 * 5) =
+  // 0.25 um from the arc, and the input polyline (steps up to 0.13 mm) is
+  // itself that close to it.
+  EXPECT_GT(rr.max_deviation_mm, 0.0);
+  EXPECT_LT(rr.max_deviation_mm, 1e-3);
+  EXPECT_LE(rr.mean_deviation_mm, rr.max_deviation_mm);
   const size_t n = r.pointCount();
   for (size_t i = 1; i + 1 < n; ++i) {
     const float* a = r.point(i - 1);
@@ -393,6 +399,17 @@ TEST(FibletCodec, resamplingMakesStepsConstantSoOnlyTheLastSegmentIsAnException)
   EXPECT_EQ(report.angle_splits, 0u);
   EXPECT_LE(measureCodecError(r, f, FibletDecoder(params)).max_um, 10.0);
   EXPECT_THROW(resampleToStep(t, 0), Error);
+  // A polyline with a corner: the chord across the corner is measured.
+  const float corner[9] = {0, 0, 0, 1, 0, 0, 1, 1, 0};
+  Tractogram bent;
+  bent.addStreamline(corner, 3);
+  ResampleReport cr;
+  resampleToStep(bent, 0.3, &cr);
+  // Points at 0.3, 0.6, 0.9 on x, then the chord from (0.9, 0, 0) to where the
+  // 0.3 sphere meets x = 1 (y = sqrt(0.09 - 0.01)) passes the corner at
+  // distance 0.1 * y / 0.3.
+  const double y = std::sqrt(0.08);
+  EXPECT_NEAR(cr.max_deviation_mm, 0.1 * y / 0.3, 1e-6);
 }
 
 TEST(FibletCodec, errorMeterPercentileAndMean) {
