@@ -127,6 +127,9 @@ size_t FibletEncoder::encodeFiblet(size_t first, size_t n, bool begins, EncodedF
           ++report_.error_splits;
           break;
         }
+      } else if (options_.mode == EncodeMode::DecodedFrame) {
+        const double local[3] = {dot3(w.c0, seg), dot3(w.c1, seg), dot3(w.c2, seg)};
+        code = encodeDirection(local, alpha);
       } else {
         const double local[3] = {dot3(truth.c0, seg), dot3(truth.c1, seg), dot3(truth.c2, seg)};
         code = encodeDirection(local, alpha);

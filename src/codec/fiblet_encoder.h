@@ -17,6 +17,11 @@ enum class EncodeMode : uint8_t {
   // previous true direction, is quantised to the nearest code; the decoded
   // path drifts as quantisation errors accumulate.
   OpenLoop,
+  // Between the two: the true direction of each segment expressed in the
+  // decoder's frame (the encoder tracks the decoded frame but not the
+  // decoded position), so heading errors do not accumulate but position
+  // errors still do, as a random walk.
+  DecodedFrame,
   // At each point, the code among the (2r+1)^2 cells around the open-loop
   // one whose decoded point lands nearest the original point; the target
   // direction is taken from the decoded frame, so errors do not accumulate.

@@ -198,17 +198,23 @@ void checkErrorTargets(double step, double max_um, double mean_um) {
   const CodecParams params = chooseCodecParams(t);
   const Coded closed = encodeAndMeasure(t, params, EncodeMode::ClosedLoop);
   const Coded open = encodeAndMeasure(t, params, EncodeMode::OpenLoop);
+  const Coded frame = encodeAndMeasure(t, params, EncodeMode::DecodedFrame);
   const double bytes = double(closed.fiblets.bytes.size() + closed.fiblets.tableBytes()) / double(t.pointCount());
   std::cout << "[fiblet " << step << " mm] points " << t.pointCount() << ", alpha "
             << params.alpha / kDeg << " deg; closed loop max " << closed.error.max_um << " um, mean "
             << closed.error.mean_um << " um, p99 " << closed.error.p99_um << " um, splits "
             << closed.report.splits() << " (angle " << closed.report.angle_splits << ", error "
             << closed.report.error_splits << "); open loop max " << open.error.max_um << " um, mean "
-            << open.error.mean_um << " um, splits " << open.report.splits() << "; " << bytes
+            << open.error.mean_um << " um; decoded-frame open loop max " << frame.error.max_um << " um, mean "
+            << frame.error.mean_um << " um; " << bytes
             << " bytes/point\n";
   EXPECT_LE(closed.error.max_um, max_um);
   EXPECT_LE(closed.error.mean_um, mean_um);
   EXPECT_LE(closed.error.max_um, 0.5 * open.error.max_um);
+  EXPECT_LE(closed.error.max_um, 0.5 * frame.error.max_um);
+  // Tracking the decoded frame stops the heading drift of the true-frame open loop.
+  EXPECT_LT(frame.error.max_um, open.error.max_um);
+  EXPECT_EQ(frame.fiblets.fibletCount(), open.fiblets.fibletCount());
   EXPECT_LE(bytes, 1.30);
   EXPECT_EQ(closed.report.points, t.pointCount());
 }
