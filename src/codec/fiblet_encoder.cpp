@@ -16,7 +16,9 @@ uint32_t encodeDirection(const double direction[3], double alpha) {
   const double norm =
       std::sqrt(direction[0] * direction[0] + direction[1] * direction[1] + direction[2] * direction[2]);
   double x = 0, y = 0, z = 1;
-  if (norm > 0) {
+  // Non-finite input (NaN points) encodes as straight ahead rather than
+  // reaching an out-of-range float -> int conversion.
+  if (norm > 0 && std::isfinite(norm)) {
     x = direction[0] / norm;
     y = direction[1] / norm;
     z = direction[2] / norm;
@@ -63,8 +65,10 @@ size_t FibletEncoder::encodeFiblet(size_t first, size_t n, bool begins, EncodedF
     float c[3];
     for (int axis = 0; axis < 3; ++axis) {
       const double scaled = t[3 * index + axis] * shader::kFibletQuantMax;
-      if (which == 0 && !(scaled >= -0.5 && scaled <= shader::kFibletQuantMax + 0.5)) ++report_.clamped_points;
-      const auto q = uint32_t(std::clamp(std::nearbyint(scaled), 0.0, double(shader::kFibletQuantMax)));
+      const bool inside = scaled >= -0.5 && scaled <= shader::kFibletQuantMax + 0.5;  // false for NaN
+      if (!inside && axis == 0 && (which == 0 || first + 1 < n)) ++report_.clamped_points;
+      const uint32_t q = inside ? uint32_t(std::nearbyint(std::clamp(scaled, 0.0, double(shader::kFibletQuantMax))))
+                                : (scaled > 0 ? shader::kFibletQuantMax : 0u);
       out.bytes[base + 6 * size_t(which) + 2 * size_t(axis)] = uint8_t(q);
       out.bytes[base + 6 * size_t(which) + 2 * size_t(axis) + 1] = uint8_t(q >> 8);
       c[axis] = shader::fibletDequantize(q);

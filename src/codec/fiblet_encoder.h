@@ -51,7 +51,7 @@ struct EncodeReport {
   uint64_t error_splits = 0;  // closed-loop points that would exceed max_point_error
   uint64_t single_point_fibers = 0;
   uint64_t two_point_fibers = 0;
-  uint64_t clamped_points = 0;  // outside the normalisation box (clamped to [0,1]^3)
+  uint64_t clamped_points = 0;  // stored points outside the normalisation box or not finite (clamped to [0,1]^3)
 
   uint64_t splits() const { return angle_splits + step_splits + error_splits; }
 };

@@ -418,6 +418,26 @@ TEST(FibletCodec, resamplingMakesStepsConstantSoOnlyTheLastSegmentIsAnException)
   EXPECT_NEAR(cr.max_deviation_mm, 0.1 * y / 0.3, 1e-6);
 }
 
+TEST(FibletCodec, pointsOutsideTheBoxOrNotFiniteAreClampedAndCounted) {
+  Tractogram t;
+  const float inside[9] = {0, 0, 0, 0.1f, 0, 0, 0.2f, 0, 0};
+  t.addStreamline(inside, 3);
+  const CodecParams params = chooseCodecParams(t);
+  Tractogram bad;
+  const float nan = std::nanf("");
+  const float outside[15] = {nan, 0, 0, 0.1f, nan, 0, 500, 0, 0, -1e30f, 0, 0, 0.3f, 0, 0};
+  bad.addStreamline(outside, 5);
+  for (EncodeMode mode : {EncodeMode::ClosedLoop, EncodeMode::OpenLoop, EncodeMode::DecodedFrame}) {
+    EncodeOptions options;
+    options.mode = mode;
+    EncodeReport report;
+    const EncodedFiblets f = encodeTractogram(bad, params, options, &report);
+    EXPECT_GE(report.clamped_points, 1u);
+    EXPECT_EQ(validateFiblets(f, params), "");
+    EXPECT_EQ(FibletDecoder(params).decodeAll(f).pointCount(), 5u);
+  }
+}
+
 TEST(FibletCodec, errorMeterPercentileAndMean) {
   CodecErrorMeter meter;
   for (int i = 1; i <= 1000; ++i) meter.add(i * 0.01);
