@@ -191,6 +191,35 @@ TEST(FblFile, roundTripKeepsHeaderAndEverySection) {
   EXPECT_NO_THROW(f.verify("fiblets"));
 }
 
+// fuzz/seeds/fbl.py writes .fbl files from docs/FBL_FORMAT.md with its own
+// CRC-32C: an independent writer the reader must accept value for value.
+TEST(FblFile, readsFilesWrittenByTheIndependentPythonWriter) {
+  if (!std::filesystem::exists("/usr/bin/python3")) GTEST_SKIP() << "/usr/bin/python3 is missing";
+  TempDir dir;
+  const std::string script = std::string(FIBSCOPE_TEST_TOOLS_DIR) + "/../../fuzz/seeds/fbl.py";
+  const auto result = test::runCommand("/usr/bin/python3 '" + script + "' '" + dir.path() + "'");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const FblFile f = FblFile::open(dir.file("sample.fbl"));
+  f.verify();
+  EXPECT_EQ(f.header().fiber_count, 2u);
+  EXPECT_EQ(f.header().fiblet_count, 3u);
+  EXPECT_EQ(f.header().point_count, 70u);
+  EXPECT_EQ(f.header().points_per_fiblet, 60u);
+  EXPECT_EQ(f.header().fiblet_record_bytes, 16u);
+  EXPECT_EQ(f.header().translation[1], -126.0);
+  EXPECT_EQ(f.header().scale, 180.0);
+  EXPECT_EQ(f.header().alpha, 0.5);
+  EXPECT_EQ(f.header().v[2], 0.75f);
+  const auto first = f.array<uint64_t>(*f.find("fiber_first_fiblet"));
+  EXPECT_EQ(std::vector<uint64_t>(first.begin(), first.end()), (std::vector<uint64_t>{0, 2, 3}));
+  const auto colour = f.array<float>(*f.find("dps/colour"));
+  EXPECT_EQ(std::vector<float>(colour.begin(), colour.end()), (std::vector<float>{1, 0, 0, 0, 1, 0}));
+  const auto source = f.data("source");
+  EXPECT_NE(std::string(source.begin(), source.end()).find("brain.trk"), std::string::npos);
+  EXPECT_NO_THROW(FblFile::open(dir.file("empty.fbl")).verify());
+  EXPECT_TRUE(FblFile::open(dir.file("no_sections.fbl")).sections().empty());
+}
+
 TEST(FblFile, everySectionAndTheFileEndAre64ByteAligned) {
   TempDir dir;
   const std::string path = dir.file("a.fbl");
