@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <string>
 
 #include "core/error.h"
 
@@ -201,6 +202,9 @@ double pointSegmentDistance(const float* p, const double a[3], const double b[3]
 
 }  // namespace
 
+// More points than a fiber can have in the fiblet tables (uint32 counts).
+constexpr uint64_t kMaxResampledPoints = uint64_t(1) << 31;
+
 Tractogram resampleToStep(const Tractogram& in, double step_mm, ResampleReport* report) {
   if (!(step_mm > 0) || !std::isfinite(step_mm)) fail("resample", "step must be finite and > 0");
   Tractogram out;
@@ -213,6 +217,19 @@ Tractogram resampleToStep(const Tractogram& in, double step_mm, ResampleReport* 
   for (size_t s = 0; s < in.streamlineCount(); ++s) {
     const float* p = in.point(in.offsets[s]);
     const size_t n = in.pointsIn(s);
+    // Check before walking: a NaN would never leave the sphere test, and an
+    // absurd length would allocate without bound.
+    double length = 0;
+    for (size_t i = 0; i < 3 * n; ++i)
+      if (!std::isfinite(p[i])) fail("resample", "streamline " + std::to_string(s) + " has a non-finite coordinate");
+    for (size_t i = 1; i < n; ++i) {
+      const float* a = p + 3 * (i - 1);
+      length += std::sqrt(std::pow(double(p[3 * i]) - a[0], 2) + std::pow(double(p[3 * i + 1]) - a[1], 2) +
+                          std::pow(double(p[3 * i + 2]) - a[2], 2));
+    }
+    if (length / step_mm > double(kMaxResampledPoints))
+      fail("resample", "streamline " + std::to_string(s) + " is " + std::to_string(length) + " mm long, more than " +
+                           std::to_string(kMaxResampledPoints) + " steps of " + std::to_string(step_mm) + " mm");
     if (n > 0) out.positions.insert(out.positions.end(), p, p + 3);
     if (n >= 2) {
       double cur[3] = {p[0], p[1], p[2]};

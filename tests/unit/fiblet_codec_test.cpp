@@ -405,6 +405,14 @@ TEST(FibletCodec, resamplingMakesStepsConstantSoOnlyTheLastSegmentIsAnException)
   EXPECT_EQ(report.angle_splits, 0u);
   EXPECT_LE(measureCodecError(r, f, FibletDecoder(params)).max_um, 10.0);
   EXPECT_THROW(resampleToStep(t, 0), Error);
+  Tractogram far;
+  const float jump[6] = {0, 0, 0, 1e30f, 0, 0};
+  far.addStreamline(jump, 2);
+  EXPECT_THROW(resampleToStep(far, 0.1), Error);
+  Tractogram nan;
+  const float bad[6] = {0, 0, 0, std::nanf(""), 0, 0};
+  nan.addStreamline(bad, 2);
+  EXPECT_THROW(resampleToStep(nan, 0.1), Error);
   // A polyline with a corner: the chord across the corner is measured.
   const float corner[9] = {0, 0, 0, 1, 0, 0, 1, 1, 0};
   Tractogram bent;
