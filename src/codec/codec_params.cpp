@@ -72,6 +72,10 @@ void CodecParamEstimator::add(const Tractogram& chunk) {
       const float* q = chunk.point(first + i - 1);
       const double d[3] = {double(p[0]) - q[0], double(p[1]) - q[1], double(p[2]) - q[2]};
       const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+      if (!std::isfinite(len)) {  // a NaN or infinite point: no step or turn to measure here
+        have_prev = false;
+        continue;
+      }
       lengths_.push(float(len), options_.max_samples);
       if (len > 0 && have_prev) {
         const double c = (d[0] * prev[0] + d[1] * prev[1] + d[2] * prev[2]) / len;

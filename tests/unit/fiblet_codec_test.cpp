@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <numbers>
 
@@ -175,6 +176,18 @@ TEST(FibletParams, stepIsTheMedianSegmentAndAlphaComesFromTheBulkOfTurns) {
     hi = std::max(hi, n);
   }
   EXPECT_NEAR(hi, 1.0, 1e-6);
+}
+
+TEST(FibletParams, nonFinitePointsAreLeftOutOfTheStatistics) {
+  Tractogram t;
+  const float xyz[15] = {0, 0, 0, 0.2f, 0, 0, std::nanf(""), 0, 0, 0.4f, 0, 0, 0.6f, 0, 0};
+  t.addStreamline(xyz, 5);
+  const CodecParams p = chooseCodecParams(t);
+  EXPECT_NEAR(p.deltaMm(), 0.2, 1e-6);
+  EXPECT_NEAR(p.scale, 1 / 0.6, 1e-5);
+  const float inf[6] = {0, 0, 0, std::numeric_limits<float>::infinity(), 0, 0};
+  t.addStreamline(inf, 2);
+  EXPECT_THROW(chooseCodecParams(t), Error);
 }
 
 TEST(FibletParams, invalidParametersAreRejected) {
