@@ -22,15 +22,18 @@ enum class EncodeMode : uint8_t {
   // decoded position), so heading errors do not accumulate but position
   // errors still do, as a random walk.
   DecodedFrame,
-  // At each point, the code among the (2r+1)^2 cells around the open-loop
-  // one whose decoded point lands nearest the original point; the target
-  // direction is taken from the decoded frame, so errors do not accumulate.
+  // At each point, the code among the (2r+1)^2 cells around the one aimed
+  // from the decoded point and frame at the original point, whose decoded
+  // point lands nearest the original point, so errors do not accumulate.
   ClosedLoop,
 };
 
 struct EncodeOptions {
   EncodeMode mode = EncodeMode::ClosedLoop;
-  int search_radius = 2;  // closed loop: cells searched each side of the open-loop cell (2 = 5x5)
+  // Closed loop: cells searched each side of the cell aimed at the original
+  // point (1 = 3x3). On the phantom at 0.1 and 0.05 mm, 3x3 and 5x5 give the
+  // same figures (max 2.76 / 2.70 um); 1x1 is 8% worse in max error.
+  int search_radius = 1;
   // A segment whose length differs from delta by more than this fraction of
   // delta starts a new fiblet (the segment becomes the join between two
   // fiblets, which stores both its ends exactly).
