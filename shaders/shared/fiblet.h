@@ -174,9 +174,11 @@ SHADER_FN FibletTransform fibletCompose(FibletTransform a, FibletTransform b) {
   return r;
 }
 
-SHADER_STATIC_ASSERT(kFibletMaxPoints <= 63u, "the point count has 6 bits");
-SHADER_STATIC_ASSERT(sizeof(FibletTransform) == 48, "FibletTransform is 12 floats");
-SHADER_STATIC_ASSERT(sizeof(vec4) == 16, "direction table entries are std430 vec4");
+#ifdef __cplusplus
+static_assert(kFibletMaxPoints <= 63u, "the point count has 6 bits");
+static_assert(sizeof(FibletTransform) == 48, "FibletTransform is 12 floats");
+static_assert(sizeof(vec4) == 16, "direction table entries are std430 vec4");
+#endif
 
 // Octahedral cell centre of a code as an unnormalised upper-hemisphere
 // vector: the high nibble indexes u, the low nibble v, (u, v) in [-1, 1]^2

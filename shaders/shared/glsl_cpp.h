@@ -29,7 +29,6 @@
 #define SHADER_FN inline
 #define SHADER_NAMESPACE_BEGIN namespace fibscope::shader {
 #define SHADER_NAMESPACE_END }
-#define SHADER_STATIC_ASSERT(cond, msg) static_assert(cond, msg)
 
 namespace fibscope::shader {
 
@@ -87,7 +86,6 @@ inline float uintBitsToFloat(uint v) { return std::bit_cast<float>(v); }
 #define SHADER_FN
 #define SHADER_NAMESPACE_BEGIN
 #define SHADER_NAMESPACE_END
-#define SHADER_STATIC_ASSERT(cond, msg)
 
 #endif
 
