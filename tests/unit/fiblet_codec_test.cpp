@@ -459,6 +459,34 @@ TEST(FibletCodec, pointsOutsideTheBoxOrNotFiniteAreClampedAndCounted) {
   }
 }
 
+TEST(FibletCodec, streamedChunksEncodeExactlyAsOneCall) {
+  const Tractogram& t = phantom(0.1);
+  const CodecParams params = chooseCodecParams(t);
+  const EncodedFiblets whole = encodeTractogram(t, params);
+  // A streaming caller: encode 37 streamlines at a time, move the records
+  // and tables out, advance fiblet_base.
+  FibletEncoder encoder(params);
+  EncodedFiblets chunk, joined;
+  for (size_t s = 0; s < t.streamlineCount(); ++s) {
+    encoder.encodeStreamline(t.point(t.offsets[s]), t.pointsIn(s), chunk);
+    if (s % 37 == 36 || s + 1 == t.streamlineCount()) {
+      EXPECT_EQ(validateFiblets(chunk, params), "");
+      joined.bytes.insert(joined.bytes.end(), chunk.bytes.begin(), chunk.bytes.end());
+      joined.fiber_first_fiblet.insert(joined.fiber_first_fiblet.end(), chunk.fiber_first_fiblet.begin(),
+                                       chunk.fiber_first_fiblet.end());
+      joined.fiber_points.insert(joined.fiber_points.end(), chunk.fiber_points.begin(), chunk.fiber_points.end());
+      chunk.fiblet_base += chunk.fibletCount();
+      chunk.bytes.clear();
+      chunk.fiber_first_fiblet.clear();
+      chunk.fiber_points.clear();
+    }
+  }
+  EXPECT_EQ(joined.bytes, whole.bytes);
+  EXPECT_EQ(joined.fiber_first_fiblet, whole.fiber_first_fiblet);
+  EXPECT_EQ(joined.fiber_points, whole.fiber_points);
+  EXPECT_EQ(encoder.report().fiblets, whole.fibletCount());
+}
+
 TEST(FibletCodec, errorMeterPercentileAndMean) {
   CodecErrorMeter meter;
   for (int i = 1; i <= 1000; ++i) meter.add(i * 0.01);
