@@ -14,7 +14,7 @@ packages=(g++ cmake ninja-build pkg-config libgtest-dev libbenchmark-dev libcli1
           nlohmann-json3-dev libzip-dev zlib1g-dev)
 # Independent references for the tests (nibabel, MRtrix3) and the fuzzers (clang, libFuzzer).
 if [ "$mode" = test ]; then
-  packages+=(python3 python3-numpy python3-nibabel mrtrix3 clang libclang-rt-14-dev)
+  packages+=(python3 python3-numpy python3-nibabel mrtrix3 clang libclang-rt-14-dev glslang-tools)
 fi
 
 missing=()

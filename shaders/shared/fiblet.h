@@ -125,7 +125,14 @@ SHADER_FN vec3 fibletNormalize(vec3 v) {
 SHADER_FN FibletTransform fibletFrameFromForward(vec3 f, vec3 v) {
   SHADER_PRECISE vec3 right = fibletNormalize(fibletCross(f, v));
   SHADER_PRECISE vec3 up = fibletCross(right, f);
-  return FibletTransform(right, up, f, vec3(0.0f));
+  // Member by member: GLSL's constructor syntax FibletTransform(a, b, c, d)
+  // is C++20 parenthesised aggregate initialisation, which clang 14 lacks.
+  FibletTransform frame;
+  frame.c0 = right;
+  frame.c1 = up;
+  frame.c2 = f;
+  frame.t = vec3(0.0f);
+  return frame;
 }
 
 // A unit vector perpendicular to v (unit): the fallback constant vector for
