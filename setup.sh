@@ -51,7 +51,6 @@ if [ "$mode" = run ]; then
 fi
 
 # Tests: the optimised build, then the same tests under ASan + UBSan.
-export FIBSCOPE_TEST_PYTHON=/usr/bin/python3
 status=0
 (cd build && ctest --output-on-failure -j "$jobs" --timeout 600) || status=1
 configure build-asan -DCMAKE_BUILD_TYPE=Debug -DFIBSCOPE_SANITIZE=ON -DFIBSCOPE_BENCH=OFF
