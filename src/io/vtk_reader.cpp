@@ -39,7 +39,11 @@ enum class Scalar { kInt8, kUInt8, kInt16, kUInt16, kInt32, kUInt32, kInt64, kUI
 struct ValueType {
   Scalar scalar = Scalar::kFloat32;
   size_t bytes = 4;
-  bool integral() const { return scalar != Scalar::kFloat32 && scalar != Scalar::kFloat64; }
+  // Bit and string arrays (no fixed byte size) are neither integral nor floating.
+  bool integral() const {
+    return scalar != Scalar::kFloat32 && scalar != Scalar::kFloat64 && scalar != Scalar::kBit &&
+           scalar != Scalar::kString;
+  }
 };
 
 std::string lowerCase(std::string_view s) {

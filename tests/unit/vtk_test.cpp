@@ -221,6 +221,15 @@ TEST(VtkReader, rejectsBadVersion51Offsets) {
               "expected connectivity");
 }
 
+// Found by fuzz_vtk: a string-typed CONNECTIVITY in a binary file was sized
+// by dividing by its element size, which is 0.
+TEST(VtkReader, rejectsNonIntegerConnectivityInBinaryFiles) {
+  expectError(std::string("# vtk DataFile Version 5.1\nt\nBINARY\nDATASET POLYDATA\nPOINTS 0 float\n\n"
+                          "LINES 1 0\nOFFSETS vtktypeint64\n") +
+                  std::string(8, '\0') + "\nCONNECTIVITY string\n",
+              "CONNECTIVITY must have an integer type");
+}
+
 TEST(VtkReader, rejectsAbsurdCountsBeforeAllocating) {
   expectError(std::string(kHead) + "POINTS 99999999999 float\n0 0 0\n", "POINTS");
   expectError(std::string(kHead) + "POINTS 1 float\n0 0 0\nLINES 1 99999999999\n", "LINES");
