@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <vector>
 
 #include "core/error.h"
 #include "io/reader.h"
@@ -67,11 +68,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     try {
       fibscope::WriterOptions options;
       options.overwrite = true;
-      fibscope::writeTractogram(p.output, all, header, options);
+      std::vector<std::string> dropped;  // arrays trk cannot name (more than 10) are dropped with a warning
+      fibscope::writeTractogram(p.output, all, header, options, &dropped);
       fibscope::Tractogram back;
       if (!readAll(p.output, &back, nullptr)) std::abort();  // what we write, we read
-      if (back.offsets != all.offsets || back.per_point.size() != all.per_point.size() ||
-          back.per_streamline.size() != all.per_streamline.size())
+      if (back.offsets != all.offsets) std::abort();
+      if (dropped.empty() && (back.per_point.size() != all.per_point.size() ||
+                              back.per_streamline.size() != all.per_streamline.size()))
         std::abort();
     } catch (const fibscope::Error& e) {
       fibscope::fuzz::checkMessage(e);  // e.g. a point outside the float range of the grid
