@@ -82,7 +82,8 @@ nlohmann::json toJson(const std::string& path, const InfoResult& r) {
   j["zero_length_segments"] = s.zero_length_segments;
   j["step_mm"] = {{"min", s.step_min}, {"median", s.step_median}, {"max", s.step_max},
                   {"fraction_within_1pct_of_median", s.step_within_1pct}};
-  j["turning_angle_deg"] = {{"max", s.angle_max_deg}, {"p99_9", s.angle_p999_deg}};
+  j["turning_angle_deg"] = {{"mean", s.angle_mean_deg}, {"p50", s.angle_p50_deg}, {"p99", s.angle_p99_deg},
+                            {"p99_9", s.angle_p999_deg}, {"max", s.angle_max_deg}};
   j["bounding_box_mm"] = {{"min", s.bbox_min}, {"max", s.bbox_max}};
   j["length_mm"] = {{"min", s.length_min}, {"mean", s.length_mean}, {"max", s.length_max}};
   j["per_streamline"] = arraysJson(r.header.per_streamline);
@@ -116,7 +117,8 @@ void printText(const std::string& path, const InfoResult& r) {
               s.step_min, s.step_median, s.step_max, 100.0 * s.step_within_1pct);
   if (s.zero_length_segments)
     std::printf("  zero-length segments  %llu\n", static_cast<unsigned long long>(s.zero_length_segments));
-  std::printf("  turning angle (deg)   max %.3f  99.9th percentile %.3f\n", s.angle_max_deg, s.angle_p999_deg);
+  std::printf("  turning angle (deg)   mean %.3f  median %.3f  p99 %.3f  p99.9 %.3f  max %.3f\n", s.angle_mean_deg,
+              s.angle_p50_deg, s.angle_p99_deg, s.angle_p999_deg, s.angle_max_deg);
   std::printf("  bounding box (mm)     [%.2f %.2f %.2f] .. [%.2f %.2f %.2f]\n", s.bbox_min[0], s.bbox_min[1],
               s.bbox_min[2], s.bbox_max[0], s.bbox_max[1], s.bbox_max[2]);
   std::printf("  length (mm)           min %.3f  mean %.3f  max %.3f\n", s.length_min, s.length_mean, s.length_max);

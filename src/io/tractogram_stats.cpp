@@ -54,11 +54,14 @@ void TractogramStatsAccumulator::add(const Tractogram& t) {
     if (n < 2) continue;
     s_.segments += n - 1;
     double length = 0;
-    float prev[3] = {0, 0, 0};
+    double prev[3] = {0, 0, 0};
     bool have_prev = false;
     for (size_t i = begin; i + 1 < begin + n; ++i) {
-      const float d[3] = {p[3 * i + 3] - p[3 * i], p[3 * i + 4] - p[3 * i + 1], p[3 * i + 5] - p[3 * i + 2]};
-      const double len2 = double(d[0]) * d[0] + double(d[1]) * d[1] + double(d[2]) * d[2];
+      // Differences in double: a float subtraction of two coordinates would
+      // round the step (e.g. 50.1 - 49.9) before it is measured.
+      const double d[3] = {double(p[3 * i + 3]) - p[3 * i], double(p[3 * i + 4]) - p[3 * i + 1],
+                           double(p[3 * i + 5]) - p[3 * i + 2]};
+      const double len2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
       const double step = std::sqrt(len2);
       length += step;
       if (step == 0) {
@@ -69,11 +72,12 @@ void TractogramStatsAccumulator::add(const Tractogram& t) {
       step_max_ = std::max(step_max_, step);
       ++step_hist_[stepBin(static_cast<float>(step))];
       if (have_prev) {
-        const double dot = double(prev[0]) * d[0] + double(prev[1]) * d[1] + double(prev[2]) * d[2];
-        const double plen = std::sqrt(double(prev[0]) * prev[0] + double(prev[1]) * prev[1] + double(prev[2]) * prev[2]);
+        const double dot = prev[0] * d[0] + prev[1] * d[1] + prev[2] * d[2];
+        const double plen = std::sqrt(prev[0] * prev[0] + prev[1] * prev[1] + prev[2] * prev[2]);
         const double c = std::clamp(dot / (plen * step), -1.0, 1.0);
         const double angle = std::acos(c) * (180.0 / M_PI);
         angle_max_ = std::max(angle_max_, angle);
+        angle_sum_ += angle;
         ++angle_hist_[std::min(kAngleBins - 1, static_cast<size_t>(angle / kAngleBinDeg))];
       }
       std::copy(d, d + 3, prev);
@@ -96,6 +100,7 @@ void TractogramStatsAccumulator::merge(const TractogramStatsAccumulator& o) {
   step_min_ = std::min(step_min_, o.step_min_);
   step_max_ = std::max(step_max_, o.step_max_);
   angle_max_ = std::max(angle_max_, o.angle_max_);
+  angle_sum_ += o.angle_sum_;
   length_min_ = std::min(length_min_, o.length_min_);
   length_max_ = std::max(length_max_, o.length_max_);
   for (int k = 0; k < 3; ++k) {
@@ -104,6 +109,17 @@ void TractogramStatsAccumulator::merge(const TractogramStatsAccumulator& o) {
   }
   for (size_t i = 0; i < step_hist_.size(); ++i) step_hist_[i] += o.step_hist_[i];
   for (size_t i = 0; i < angle_hist_.size(); ++i) angle_hist_[i] += o.angle_hist_[i];
+}
+
+// The smallest bin edge with at least `fraction` of the samples at or below it.
+double TractogramStatsAccumulator::anglePercentile(uint64_t angles, double fraction) const {
+  const auto target = static_cast<uint64_t>(std::ceil(fraction * double(angles)));
+  uint64_t seen = 0;
+  for (size_t i = 0; i < angle_hist_.size(); ++i) {
+    seen += angle_hist_[i];
+    if (seen >= target) return std::min(angle_max_, (double(i) + 1) * kAngleBinDeg);
+  }
+  return angle_max_;
 }
 
 TractogramStats TractogramStatsAccumulator::result() const {
@@ -134,16 +150,10 @@ TractogramStats TractogramStatsAccumulator::result() const {
   for (uint64_t c : angle_hist_) angles += c;
   if (angles > 0) {
     r.angle_max_deg = angle_max_;
-    // 99.9th percentile: smallest angle with at least 99.9 % of samples at or below it.
-    const uint64_t target = static_cast<uint64_t>(std::ceil(0.999 * double(angles)));
-    uint64_t seen = 0;
-    for (size_t i = 0; i < angle_hist_.size(); ++i) {
-      seen += angle_hist_[i];
-      if (seen >= target) {
-        r.angle_p999_deg = std::min(angle_max_, (double(i) + 1) * kAngleBinDeg);
-        break;
-      }
-    }
+    r.angle_mean_deg = angle_sum_ / double(angles);
+    r.angle_p50_deg = anglePercentile(angles, 0.5);
+    r.angle_p99_deg = anglePercentile(angles, 0.99);
+    r.angle_p999_deg = anglePercentile(angles, 0.999);
   }
   if (r.points > 0) {
     r.bbox_min = lo_;

@@ -23,7 +23,9 @@ struct TractogramStats {
 
   double step_min = 0, step_median = 0, step_max = 0;
   double step_within_1pct = 0;       // fraction of segments within 1 % of the median step
-  double angle_max_deg = 0, angle_p999_deg = 0;  // turning angle between consecutive segments
+  // Turning angle between consecutive segments; percentiles are the upper
+  // edge of their 0.001-degree bin (never above the max).
+  double angle_mean_deg = 0, angle_p50_deg = 0, angle_p99_deg = 0, angle_p999_deg = 0, angle_max_deg = 0;
   std::array<double, 3> bbox_min{}, bbox_max{};
   double length_min = 0, length_mean = 0, length_max = 0;  // mm, along the polyline
 };
@@ -39,11 +41,12 @@ class TractogramStatsAccumulator {
  private:
   static size_t stepBin(float step);
   static double stepBinValue(size_t bin);
+  double anglePercentile(uint64_t angles, double fraction) const;
 
   TractogramStats s_;
   double length_sum_ = 0;
   double step_min_ = std::numeric_limits<double>::infinity(), step_max_ = 0;
-  double angle_max_ = 0;
+  double angle_max_ = 0, angle_sum_ = 0;
   double length_min_ = std::numeric_limits<double>::infinity(), length_max_ = 0;
   std::array<double, 3> lo_, hi_;
   std::vector<uint64_t> step_hist_;

@@ -25,7 +25,7 @@ struct PhantomEstimate {
   // Segment lengths, mm.
   double segment_min_mm = 0, segment_max_mm = 0;
   // Turning angle between consecutive segments, degrees; percentiles from a
-  // histogram of 0.01-degree bins (upper bin edge).
+  // histogram of 0.001-degree bins (upper bin edge), as TractogramStats.
   double turn_mean_deg = 0, turn_p50_deg = 0, turn_p99_deg = 0, turn_p999_deg = 0, turn_max_deg = 0;
   std::array<uint64_t, kPhantomBundleCount> bundle_streamlines{};
 
