@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "app/commands.h"
+#include "app/open_input.h"
 #include "core/output_file.h"
 #include "core/progress.h"
 #include "io/reader.h"
@@ -19,7 +20,7 @@ void addConvertCommand(CLI::App& app) {
     bool trx_directory = false;
   };
   auto opt = std::make_shared<Options>();
-  CLI::App* cmd = app.add_subcommand("convert", "Convert between .tck, .trk, .trx (and read .vtk)");
+  CLI::App* cmd = app.add_subcommand("convert", "Convert between .tck, .trk, .trx (and read .vtk, .fbl)");
   cmd->add_option("input", opt->input, "Input tractogram")->required();
   cmd->add_option("output", opt->output, "Output tractogram (.tck .trk .trx)")->required();
   cmd->add_flag("--force,-f", opt->force, "Overwrite the output if it exists");
@@ -31,7 +32,7 @@ void addConvertCommand(CLI::App& app) {
   cmd->callback([opt] {
     // Refuse before reading anything: never overwrite silently.
     checkOverwrite(opt->output, opt->force);
-    auto reader = openTractogram(opt->input);
+    auto reader = openInput(opt->input);
     WriterOptions wo = opt->writer;
     wo.overwrite = opt->force;
     wo.trx_zip = !opt->trx_directory;

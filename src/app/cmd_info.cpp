@@ -1,10 +1,17 @@
-// `fibscope info FILE...`: counts, geometry statistics and data arrays.
+// `fibscope info FILE...`: counts, geometry statistics and data arrays; for
+// a .fbl also the container and codec facts, every section's checksum and
+// what the original file was.
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <numbers>
+#include <optional>
 
 #include "app/commands.h"
+#include "app/open_input.h"
+#include "codec/fbl_file.h"
+#include "core/error.h"
 #include "core/progress.h"
 #include "io/reader.h"
 #include "io/tractogram_stats.h"
@@ -41,6 +48,118 @@ nlohmann::json arraysJson(const std::vector<DataArray>& arrays) {
   return j;
 }
 
+// What a .fbl holds besides the streamlines. Gathered from the container
+// alone, so that a file whose fiblets fail to decode can still show which
+// section is damaged.
+struct FblSectionInfo {
+  FblSection section;
+  bool checksum_ok = false;
+};
+
+struct FblInfo {
+  uint32_t format_version = 0;
+  FblHeaderFields fields;
+  uint64_t file_bytes = 0;
+  std::vector<FblSectionInfo> sections;
+  // From the "source" JSON, when it is intact and parses.
+  std::string source_format, source_path;
+  std::vector<DataArray> dropped_per_point;
+};
+
+FblInfo inspectFbl(const std::string& path) {
+  const FblFile file = FblFile::open(path);
+  FblInfo info;
+  info.format_version = file.formatVersion();
+  info.fields = file.header();
+  info.file_bytes = file.fileBytes();
+  for (const FblSection& s : file.sections()) {
+    FblSectionInfo si{s, true};
+    try {
+      file.verify(s.name);
+    } catch (const Error&) {
+      si.checksum_ok = false;
+    }
+    info.sections.push_back(std::move(si));
+    if (s.name == kFblSectionSource && info.sections.back().checksum_ok && s.dtype == FblDType::kUtf8) {
+      // Best effort: the reader reports a malformed source section itself.
+      const auto text = file.data(s);
+      const auto j = nlohmann::json::parse(text.begin(), text.end(), nullptr, /*allow_exceptions=*/false);
+      if (j.is_object()) try {
+        if (j.contains("format") && j["format"].is_string()) info.source_format = j["format"];
+        if (j.contains("path") && j["path"].is_string()) info.source_path = j["path"];
+        if (j.contains("dropped_per_point") && j["dropped_per_point"].is_array())
+          for (const auto& a : j["dropped_per_point"])
+            if (a.is_object() && a.contains("name") && a["name"].is_string())
+              info.dropped_per_point.push_back(
+                  {a["name"], a.value("components", 1u), a.value("dtype", std::string("float32")), {}});
+      } catch (const nlohmann::json::exception&) {
+        // A field of the wrong type: left out here, reported by the reader.
+      }
+    }
+  }
+  return info;
+}
+
+double bytesPerPoint(const FblInfo& f) {
+  return f.fields.point_count ? double(f.file_bytes) / double(f.fields.point_count) : 0.0;
+}
+
+double alphaDegrees(const FblInfo& f) { return f.fields.alpha * 180.0 / std::numbers::pi; }
+
+nlohmann::json fblJson(const FblInfo& f) {
+  nlohmann::json j;
+  j["format_version"] = f.format_version;
+  j["codec_version"] = f.fields.codec_version;
+  j["points_per_fiblet"] = f.fields.points_per_fiblet;
+  j["record_bytes"] = f.fields.fiblet_record_bytes;
+  j["delta_mm"] = f.fields.delta_mm;
+  j["alpha_deg"] = alphaDegrees(f);
+  j["v"] = {f.fields.v[0], f.fields.v[1], f.fields.v[2]};
+  j["translation_mm"] = {f.fields.translation[0], f.fields.translation[1], f.fields.translation[2]};
+  j["scale_mm"] = f.fields.scale;
+  j["fibers"] = f.fields.fiber_count;
+  j["fiblets"] = f.fields.fiblet_count;
+  j["points"] = f.fields.point_count;
+  j["file_bytes"] = f.file_bytes;
+  j["bytes_per_point"] = bytesPerPoint(f);
+  nlohmann::json sections = nlohmann::json::array();
+  for (const auto& si : f.sections)
+    sections.push_back({{"name", si.section.name},
+                        {"dtype", fblDTypeName(si.section.dtype)},
+                        {"components", si.section.components},
+                        {"elements", si.section.element_count},
+                        {"offset", si.section.offset},
+                        {"bytes", si.section.bytes},
+                        {"checksum_ok", si.checksum_ok}});
+  j["sections"] = sections;
+  j["source"] = {{"format", f.source_format}, {"path", f.source_path}, {"dropped_per_point", arraysJson(f.dropped_per_point)}};
+  return j;
+}
+
+void printFbl(const FblInfo& f) {
+  const FblHeaderFields& h = f.fields;
+  std::printf("  fbl container         version %u, fiblet codec version %u\n", f.format_version, h.codec_version);
+  std::printf("  fiblets               N = %u points, %u-byte records\n", h.points_per_fiblet, h.fiblet_record_bytes);
+  std::printf("  codec                 delta %.6g mm, alpha %.4g deg, V [%.6g %.6g %.6g]\n", h.delta_mm,
+              alphaDegrees(f), double(h.v[0]), double(h.v[1]), double(h.v[2]));
+  std::printf("  encoded               %llu fibers, %llu fiblets, %llu points\n",
+              static_cast<unsigned long long>(h.fiber_count), static_cast<unsigned long long>(h.fiblet_count),
+              static_cast<unsigned long long>(h.point_count));
+  std::printf("  size                  %llu bytes, %.4g bytes per point\n", static_cast<unsigned long long>(f.file_bytes),
+              bytesPerPoint(f));
+  std::printf("  sections\n");
+  for (const auto& si : f.sections) {
+    const FblSection& s = si.section;
+    const std::string type = fblDTypeName(s.dtype) + " x " + std::to_string(s.components);
+    std::printf("    %-22s %-14s %12llu elements %14llu bytes  CRC %s\n", s.name.c_str(), type.c_str(),
+                static_cast<unsigned long long>(s.element_count), static_cast<unsigned long long>(s.bytes),
+                si.checksum_ok ? "ok" : "BAD");
+  }
+  std::printf("  original              %s %s\n", f.source_format.empty() ? "(unknown)" : f.source_format.c_str(),
+              f.source_path.c_str());
+  std::printf("  dropped per-point     %s\n", arrayList(f.dropped_per_point).c_str());
+}
+
 struct InfoResult {
   TractogramHeader header;
   TractogramStats stats;
@@ -51,7 +170,7 @@ struct InfoResult {
 InfoResult inspect(const std::string& path, bool terminal_progress) {
   InfoResult r;
   r.bytes = pathBytes(path);
-  auto reader = openTractogram(path);
+  auto reader = openInput(path);
   Progress progress("reading " + std::filesystem::path(path).filename().string(), double(r.bytes), "bytes",
                     terminal_progress);
   TractogramStatsAccumulator acc;
@@ -67,11 +186,11 @@ InfoResult inspect(const std::string& path, bool terminal_progress) {
   return r;
 }
 
-nlohmann::json toJson(const std::string& path, const InfoResult& r) {
+nlohmann::json toJson(const std::string& path, const InfoResult& r, const std::optional<FblInfo>& fbl) {
   const TractogramStats& s = r.stats;
   nlohmann::json j;
   j["path"] = path;
-  j["format"] = r.header.format;
+  j["format"] = fbl ? std::string("fbl") : r.header.format;
   j["file_bytes"] = r.bytes;
   j["streamlines"] = s.streamlines;
   j["points"] = s.points;
@@ -97,13 +216,19 @@ nlohmann::json toJson(const std::string& path, const InfoResult& r) {
     j["voxel_sizes"] = r.header.space.voxel_sizes;
   }
   j["warnings"] = r.warnings;
+  if (fbl) j["fbl"] = fblJson(*fbl);
   return j;
 }
 
-void printText(const std::string& path, const InfoResult& r) {
+void printText(const std::string& path, const InfoResult& r, const std::optional<FblInfo>& fbl) {
   const TractogramStats& s = r.stats;
   std::printf("%s\n", path.c_str());
-  std::printf("  format                %s\n", r.header.format.c_str());
+  if (fbl) {
+    std::printf("  format                fbl (fiblets; original %s)\n", r.header.format.c_str());
+    printFbl(*fbl);
+  } else {
+    std::printf("  format                %s\n", r.header.format.c_str());
+  }
   std::printf("  file size             %s (%llu bytes)\n", formatBytes(double(r.bytes)).c_str(),
               static_cast<unsigned long long>(r.bytes));
   std::printf("  streamlines           %llu", static_cast<unsigned long long>(s.streamlines));
@@ -140,17 +265,30 @@ void addInfoCommand(CLI::App& app) {
   };
   auto opt = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand("info", "Counts, step, turning angle, extent and data of tractogram files");
-  cmd->add_option("files", opt->files, "Tractogram files (.tck .trk .trx .vtk)")->required();
+  cmd->add_option("files", opt->files, "Tractogram files (.tck .trk .trx .vtk .fbl)")->required();
   cmd->add_flag("--json", opt->json, "Print one JSON document for all files");
   cmd->callback([opt] {
     nlohmann::json all = nlohmann::json::array();
     for (const auto& path : opt->files) {
-      const InfoResult r = inspect(path, !opt->json);
+      std::optional<FblInfo> fbl;
+      if (isFblPath(path)) fbl = inspectFbl(path);
+      InfoResult r;
+      try {
+        r = inspect(path, !opt->json);
+      } catch (const Error&) {
+        // Show the container (which section is damaged) before the error.
+        if (fbl && !opt->json) {
+          std::printf("%s\n", path.c_str());
+          printFbl(*fbl);
+          std::fflush(stdout);
+        }
+        throw;
+      }
       for (const auto& w : r.warnings) std::fprintf(stderr, "fibscope: warning: %s\n", w.c_str());
       if (opt->json)
-        all.push_back(toJson(path, r));
+        all.push_back(toJson(path, r, fbl));
       else
-        printText(path, r);
+        printText(path, r, fbl);
     }
     if (opt->json) std::printf("%s\n", all.dump(2).c_str());
   });

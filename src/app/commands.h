@@ -12,5 +12,6 @@ namespace fibscope {
 void addInfoCommand(CLI::App& app);
 void addConvertCommand(CLI::App& app);
 void addPhantomCommand(CLI::App& app);
+void addDecompressCommand(CLI::App& app);
 
 }  // namespace fibscope
