@@ -292,6 +292,51 @@ TEST(FblReader, headerDescribesTheOriginalAndPerStreamlineArraysComeBack) {
   EXPECT_EQ(got_c.per_streamline[0].values, colour.values);
 }
 
+TEST(FblReader, readsTractogramsWrittenByTheIndependentPythonWriter) {
+  if (!std::filesystem::exists("/usr/bin/python3")) GTEST_SKIP() << "/usr/bin/python3 is missing";
+  TempDir dir;
+  const std::string script = std::string(FIBSCOPE_TEST_TOOLS_DIR) + "/../../fuzz/seeds/fbl_fiblets.py";
+  const auto r = test::runCommand("/usr/bin/python3 " + script + " " + dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  // fiblets_n8.fbl: N = 8, fibers of fiblets {8, 3}, {}, {1}, {8, 8, 2};
+  // fiblet i of fiber f starts at normalised (0.2 + 0.1 f + 0.01 i, 0.5,
+  // 0.5); translation (-90, -126, -72) mm, 180 mm per unit; dps/weight =
+  // 0, 1, 2, 3; a trk source with a 181 x 217 x 181 LAS grid.
+  const std::string path = dir.file("fiblets_n8.fbl");
+  auto reader = openFbl(path);
+  const TractogramHeader& h = reader->header();
+  EXPECT_EQ(h.format, "trk");
+  EXPECT_EQ(h.space.dimensions, (std::array<int32_t, 3>{181, 217, 181}));
+  EXPECT_EQ(h.space.voxel_order, "LAS");
+  EXPECT_EQ(h.property("voxel_order"), "LAS");
+  const Tractogram t = readAll(*reader, 5);
+  EXPECT_EQ(reader->bytesRead(), h.file_bytes);
+  EXPECT_EQ(t.offsets, (std::vector<uint64_t>{0, 11, 11, 12, 30}));
+  ASSERT_EQ(t.per_streamline.size(), 1u);
+  EXPECT_EQ(t.per_streamline[0].values, (std::vector<float>{0, 1, 2, 3}));
+  const double quantum = 180.0 / 65535;
+  auto expectStart = [&](uint64_t point, double x) {
+    EXPECT_NEAR(t.point(point)[0], -90 + 180 * x, quantum) << point;
+    EXPECT_NEAR(t.point(point)[1], -126 + 90.0, quantum) << point;
+    EXPECT_NEAR(t.point(point)[2], -72 + 90.0, quantum) << point;
+  };
+  expectStart(0, 0.2);
+  expectStart(8, 0.21);
+  expectStart(11, 0.4);
+  expectStart(12, 0.5);
+  expectStart(20, 0.51);
+  expectStart(28, 0.52);
+  // Consecutive points inside a fiblet are delta = 0.5 mm apart (the
+  // first segment: p1 - p0 = 0.002 units = 0.36 mm, stored exactly).
+  for (uint64_t i = 2; i < 8; ++i) {
+    const float* a = t.point(i - 1);
+    const float* b = t.point(i);
+    const double d = std::sqrt(double(b[0] - a[0]) * (b[0] - a[0]) + double(b[1] - a[1]) * (b[1] - a[1]) +
+                               double(b[2] - a[2]) * (b[2] - a[2]));
+    EXPECT_NEAR(d, 0.5, 1e-3) << i;
+  }
+}
+
 TEST(DecompressCli, trkWithSpaceAndPropertiesComesBackWithTheSameHeader) {
   TempDir dir;
   TractogramHeader phantom_header;
