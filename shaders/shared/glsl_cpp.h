@@ -13,7 +13,9 @@
 //   - every float temporary is declared SHADER_PRECISE (GLSL `precise`: no
 //     reassociation, no FMA contraction; C++ gets -ffp-contract=off from the
 //     build);
-//   - functions are declared SHADER_FN (inline in C++);
+//   - functions are declared SHADER_FN (inline in C++, forced: the encoder
+//     calls them per point, and out-of-line calls passed 48-byte transforms
+//     through the stack at a third of the encoder's time);
 //   - float literals carry `f` (in C++ a bare 1.0 is double and would change
 //     the arithmetic).
 #ifndef FIBSCOPE_SHADERS_SHARED_GLSL_CPP_H
@@ -26,7 +28,11 @@
 #include <cstdint>
 
 #define SHADER_PRECISE
+#if defined(__GNUC__)
+#define SHADER_FN [[gnu::always_inline]] inline
+#else
 #define SHADER_FN inline
+#endif
 #define SHADER_NAMESPACE_BEGIN namespace fibscope::shader {
 #define SHADER_NAMESPACE_END }
 

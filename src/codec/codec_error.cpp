@@ -20,6 +20,14 @@ void CodecErrorMeter::add(double distance_um) {
   histogram_[bin < double(kBins - 1) ? size_t(bin) : kBins - 1] += 1;
 }
 
+void CodecErrorMeter::merge(const CodecErrorMeter& other) {
+  for (size_t i = 0; i < kBins; ++i) histogram_[i] += other.histogram_[i];
+  points_ += other.points_;
+  sum_ += other.sum_;
+  sum2_ += other.sum2_;
+  max_ = std::max(max_, other.max_);
+}
+
 CodecErrorStats CodecErrorMeter::stats() const {
   CodecErrorStats s;
   s.points = points_;

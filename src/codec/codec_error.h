@@ -27,6 +27,8 @@ class CodecErrorMeter {
  public:
   CodecErrorMeter();
   void add(double distance_um);
+  // Adds the points of another meter (one meter per encoding thread).
+  void merge(const CodecErrorMeter& other);
   CodecErrorStats stats() const;
 
  private:

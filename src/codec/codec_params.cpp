@@ -41,7 +41,6 @@ float percentileOf(std::vector<float>& values, double p) {
 }
 
 void CodecParamEstimator::Sample::push(float value, size_t max_samples) {
-  if (seen++ % stride != 0) return;
   values.push_back(value);
   if (values.size() > std::max<size_t>(max_samples, 2)) {
     // Keep every other value: the sample stays every-k-th of the stream.
@@ -57,11 +56,19 @@ CodecParamEstimator::CodecParamEstimator(const CodecParamOptions& options) : opt
   hi_.fill(-std::numeric_limits<double>::infinity());
 }
 
+namespace {
+
+double lengthOf(const double d[3]) { return std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]); }
+
+}  // namespace
+
 void CodecParamEstimator::add(const Tractogram& chunk) {
+  // Every point enters the bounding box and every turn the maximum (both
+  // exact); only the sampled lengths and turns cost a sqrt or an acos.
   for (size_t s = 0; s < chunk.streamlineCount(); ++s) {
     const size_t first = chunk.offsets[s], n = chunk.pointsIn(s);
     double prev[3] = {0, 0, 0};
-    bool have_prev = false;
+    bool have_prev = false;  // prev is a finite segment of non-zero length
     for (size_t i = 0; i < n; ++i) {
       const float* p = chunk.point(first + i);
       for (int c = 0; c < 3; ++c) {
@@ -69,20 +76,33 @@ void CodecParamEstimator::add(const Tractogram& chunk) {
         hi_[c] = std::max(hi_[c], double(p[c]));
       }
       if (i == 0) continue;
-      const float* q = chunk.point(first + i - 1);
+      const float* q = p - 3;
       const double d[3] = {double(p[0]) - q[0], double(p[1]) - q[1], double(p[2]) - q[2]};
-      const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-      if (!std::isfinite(len)) {  // a NaN or infinite point: no step or turn to measure here
+      const double len2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+      if (!std::isfinite(len2)) {  // a NaN or infinite point: no step or turn to measure here
         have_prev = false;
         continue;
       }
-      lengths_.push(float(len), options_.max_samples);
-      if (len > 0 && have_prev) {
-        const double c = (d[0] * prev[0] + d[1] * prev[1] + d[2] * prev[2]) / len;
-        angles_.push(float(std::acos(std::clamp(c, -1.0, 1.0))), options_.max_samples);
+      ++segments_;
+      if (lengths_.takesNext()) lengths_.push(float(std::sqrt(len2)), options_.max_samples);
+      if (len2 > 0 && have_prev) {
+        const double dot = d[0] * prev[0] + d[1] * prev[1] + d[2] * prev[2];
+        const double prev2 = prev[0] * prev[0] + prev[1] * prev[1] + prev[2] * prev[2];
+        const double bound = max_turn_threshold_ * max_turn_threshold_ * len2 * prev2;
+        // cos(turn) < threshold, on squares: a candidate for a new maximum.
+        const bool larger = max_turn_threshold_ >= 0 ? (dot < 0 || dot * dot < bound) : (dot < 0 && dot * dot > bound);
+        const bool sampled = angles_.takesNext();
+        if (larger || sampled) {
+          const double turn = std::acos(std::clamp(dot / (std::sqrt(len2) * lengthOf(prev)), -1.0, 1.0));
+          if (sampled) angles_.push(float(turn), options_.max_samples);
+          if (turn > max_turn_) {
+            max_turn_ = turn;
+            max_turn_threshold_ = std::cos(turn) - 1e-12;
+          }
+        }
       }
-      if (len > 0) {
-        for (int c = 0; c < 3; ++c) prev[c] = d[c] / len;
+      if (len2 > 0) {
+        for (int c = 0; c < 3; ++c) prev[c] = d[c];
         have_prev = true;
       }
     }
@@ -90,37 +110,69 @@ void CodecParamEstimator::add(const Tractogram& chunk) {
   }
 }
 
-CodecParams CodecParamEstimator::finish() const {
+// Largest bounding box side accepted, in mm: far beyond any head (or any
+// animal scanned), small enough that an outlier coordinate is caught.
+constexpr double kMaxExtentMm = 1e5;
+
+CodecParamSummary CodecParamEstimator::summary(double step_tolerance) const {
   const std::string where = "codec parameters";
   if (points_ == 0) fail(where, "the tractogram has no points");
-  CodecParams params;
+  CodecParamSummary out;
+  out.points = points_;
+  out.segments = segments_;
+  out.sampled_steps = lengths_.values.size();
+  out.sampled_turns = angles_.values.size();
+  out.max_turn_deg = max_turn_ * 180.0 / std::numbers::pi;
+  CodecParams& params = out.params;
   params.points_per_fiblet = options_.points_per_fiblet;
+  for (int c = 0; c < 3; ++c)
+    if (!std::isfinite(lo_[c]) || !std::isfinite(hi_[c])) fail(where, "no finite point to normalise");
   const double extent = std::max({hi_[0] - lo_[0], hi_[1] - lo_[1], hi_[2] - lo_[2]});
+  out.extent_mm = extent;
+  if (extent > kMaxExtentMm) {
+    int axis = 0;
+    for (int c = 1; c < 3; ++c)
+      if (hi_[c] - lo_[c] > hi_[axis] - lo_[axis]) axis = c;
+    fail(where, "points span " + std::to_string(extent) + " mm along " + std::string(1, "xyz"[axis]) + " (from " +
+                    std::to_string(lo_[axis]) + " to " + std::to_string(hi_[axis]) +
+                    "): not a tractogram in mm, or an outlier coordinate");
+  }
   // A single point (or a degenerate box) still gets a valid scale.
   const double scale = extent > 0 ? 1.0 / extent : 1.0;
   for (int c = 0; c < 3; ++c) params.translation[c] = float(lo_[c]);
   params.scale = float(scale);
 
   double delta_mm = options_.delta_mm;
-  if (!(delta_mm > 0)) {
+  out.delta_measured = !(delta_mm > 0);
+  if (out.delta_measured) {
     std::vector<float> lengths = lengths_.values;
     std::erase_if(lengths, [](float l) { return !(l > 0); });
     if (lengths.empty()) fail(where, "no segment of non-zero length to measure the step from");
     delta_mm = percentileOf(lengths, 50.0);
   }
+  // Float coordinates in [0, 1] resolve 6e-8; a step of fewer than ~100
+  // of those cannot hold a direction.
+  if (extent > 0 && delta_mm / extent < 1e-5)
+    fail(where, "step " + std::to_string(delta_mm) + " mm is too small for points spanning " + std::to_string(extent) +
+                    " mm (float precision)");
   params.delta = float(delta_mm * double(params.scale));
+  if (!lengths_.values.empty()) {
+    uint64_t off = 0;
+    for (float l : lengths_.values) off += std::fabs(double(l) - delta_mm) > step_tolerance * delta_mm;
+    out.steps_off_fraction = double(off) / double(lengths_.values.size());
+  }
 
   double alpha_deg = options_.alpha_deg;
-  if (!(alpha_deg > 0)) {
+  out.alpha_measured = !(alpha_deg > 0);
+  if (!angles_.values.empty()) {
     std::vector<float> angles = angles_.values;
-    const double measured =
-        angles.empty() ? 0.0 : double(percentileOf(angles, options_.alpha_percentile)) * 180.0 / std::numbers::pi;
-    alpha_deg = measured * options_.alpha_margin;
+    out.turn_percentile_deg = double(percentileOf(angles, options_.alpha_percentile)) * 180.0 / std::numbers::pi;
   }
+  if (out.alpha_measured) alpha_deg = out.turn_percentile_deg * options_.alpha_margin;
   alpha_deg = std::clamp(alpha_deg, options_.min_alpha_deg, std::min(options_.max_alpha_deg, 90.0));
   params.alpha = std::min(float(alpha_deg * std::numbers::pi / 180.0), float(std::numbers::pi / 2));
   validateCodecParams(params);
-  return params;
+  return out;
 }
 
 CodecParams chooseCodecParams(const Tractogram& tractogram, const CodecParamOptions& options) {

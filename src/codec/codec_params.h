@@ -48,6 +48,24 @@ struct CodecParamOptions {
   size_t max_samples = size_t(1) << 20;  // bound on the memory of the estimator
 };
 
+// What the estimator measured, for the compression report.
+struct CodecParamSummary {
+  CodecParams params;
+  uint64_t points = 0;
+  uint64_t segments = 0;       // finite segments seen
+  uint64_t sampled_steps = 0;  // segment lengths in the sample
+  uint64_t sampled_turns = 0;
+  double turn_percentile_deg = 0;  // the alpha_percentile-th percentile of the sampled turns
+  double max_turn_deg = 0;         // the largest turn in the whole input (exact)
+  // Fraction of the sampled segments whose length is off delta by more than
+  // `step_tolerance` (the encoder's split threshold): resampled or
+  // compressed inputs have many.
+  double steps_off_fraction = 0;
+  double extent_mm = 0;        // largest side of the bounding box
+  bool alpha_measured = false; // false when given
+  bool delta_measured = false;
+};
+
 // Measures the statistics behind CodecParams from a stream of chunks in
 // bounded memory: the exact bounding box, and a deterministic sample of
 // segment lengths and turning angles (every k-th value, k doubling whenever
@@ -63,18 +81,29 @@ class CodecParamEstimator {
   // not for the rarest one; turns above alpha become split exceptions in the
   // encoder. Throws Error when no point was seen or every segment has zero
   // length (and no delta_mm was given).
-  CodecParams finish() const;
+  // Also throws when the bounding box is absurd for a tractogram in mm
+  // (more than 100 m: an outlier coordinate would crush every other point
+  // into a few quantisation steps) or delta is too small for float precision
+  // at that scale.
+  CodecParams finish() const { return summary().params; }
+  CodecParamSummary summary(double step_tolerance = 0.05) const;
 
  private:
   struct Sample {
     std::vector<float> values;
     uint64_t seen = 0;
     uint64_t stride = 1;
+    // Whether the next value is kept (then call push): values that will be
+    // dropped need not be computed.
+    bool takesNext() { return seen++ % stride == 0; }
     void push(float value, size_t max_samples);
   };
   CodecParamOptions options_;
   std::array<double, 3> lo_, hi_;
   uint64_t points_ = 0;
+  uint64_t segments_ = 0;
+  double max_turn_ = 0;            // radians
+  double max_turn_threshold_ = 1;  // cos(max_turn_) - tiny: cheaper test for a new maximum
   Sample lengths_, angles_;
 };
 

@@ -13,36 +13,14 @@ namespace fibscope {
 using shader::FibletTransform;
 using shader::vec3;
 
-uint32_t encodeDirection(const double direction[3], double alpha) {
-  const double norm =
-      std::sqrt(direction[0] * direction[0] + direction[1] * direction[1] + direction[2] * direction[2]);
-  double x = 0, y = 0, z = 1;
-  // Non-finite input (NaN points) encodes as straight ahead rather than
-  // reaching an out-of-range float -> int conversion.
-  if (norm > 0 && std::isfinite(norm)) {
-    x = direction[0] / norm;
-    y = direction[1] / norm;
-    z = direction[2] / norm;
-  }
-  const double theta = std::min(std::acos(std::clamp(z, -1.0, 1.0)), alpha);
-  const double phi = std::atan2(y, x);
-  const double theta_h = theta * (std::numbers::pi / 2) / alpha;
-  const double hx = std::sin(theta_h) * std::cos(phi), hy = std::sin(theta_h) * std::sin(phi);
-  const double hz = std::cos(theta_h);
-  // Onto the octahedron |x| + |y| + z = 1, then the 45-degree rotation that
-  // turns its upper half into the square [-1, 1]^2 (see fibletOctahedralCell).
-  const double s = std::fabs(hx) + std::fabs(hy) + std::max(hz, 0.0);
-  const double ox = hx / s, oy = hy / s;
-  const double u = ox + oy, v = ox - oy;
-  const auto cell = [](double c) {
-    return uint32_t(std::clamp(std::floor((c + 1.0) * 8.0), 0.0, double(shader::kFibletGridSize - 1)));
-  };
-  return cell(u) << 4 | cell(v);
-}
-
 FibletEncoder::FibletEncoder(const CodecParams& params, const EncodeOptions& options)
-    : params_(params), options_(options), decoder_(params) {
+    : params_(params), options_(options), decoder_(params), quantizer_(params.alpha, params.delta),
+      um_per_unit_(1000.0 / double(params.scale)) {
   if (options.search_radius < 0 || options.search_radius > 15) fail("fiblet encoder", "search radius outside [0, 15]");
+  for (uint32_t c = 0; c < shader::kFibletCodeCount; ++c) {
+    const vec3& step = decoder_.localTransform(c).t;
+    code_steps_[c] = {double(step.x), double(step.y), double(step.z)};
+  }
 }
 
 namespace {
@@ -76,6 +54,17 @@ size_t FibletEncoder::encodeFiblet(size_t first, size_t n, bool begins, EncodedF
     }
     decoded[which] = vec3(c[0], c[1], c[2]);
   }
+  // Measures decoded point `p` against target point `index`.
+  const auto measure = [&](const vec3& p, size_t index) {
+    const double* o = t + 3 * index;
+    const double e2 = (double(p.x) - o[0]) * (double(p.x) - o[0]) + (double(p.y) - o[1]) * (double(p.y) - o[1]) +
+                      (double(p.z) - o[2]) * (double(p.z) - o[2]);
+    if (std::isfinite(e2)) meter_->add(std::sqrt(e2) * um_per_unit_);
+  };
+  if (meter_) {
+    measure(decoded[0], first);
+    if (first + 1 < n) measure(decoded[1], first + 1);
+  }
 
   const size_t count_max = std::min<size_t>(big_n, n - first);
   size_t count = std::min<size_t>(count_max, 2);
@@ -83,44 +72,54 @@ size_t FibletEncoder::encodeFiblet(size_t first, size_t n, bool begins, EncodedF
     const vec3 v(params_.v[0], params_.v[1], params_.v[2]);
     const double delta = params_.delta;
     const double alpha = params_.alpha;
-    const double cos_alpha = std::cos(alpha);
+    // Step and turn checks on squared quantities (no sqrt or division per
+    // point): |len - delta| <= tol * delta and cos(turn) >= cos(alpha), the
+    // latter with a little slack so that a turn of exactly alpha (the
+    // largest representable one) is not an exception.
+    const double len2_lo = std::pow((1 - options_.step_tolerance) * delta, 2);
+    const double len2_hi = std::pow((1 + options_.step_tolerance) * delta, 2);
+    const double cos_alpha = std::cos(alpha) - 1e-6;
+    const double cos2_alpha = cos_alpha * cos_alpha;
     const double max_error2 = std::pow(options_.max_point_error * delta, 2);
-    const bool closed = options_.mode == EncodeMode::ClosedLoop;
     const int radius = options_.search_radius;
-    // The decoder's frame, and (open loop) the frame of the true directions.
+    // The decoder's frame, and (true-frame variant) the frame of the true directions.
     FibletTransform w = shader::fibletInitialTransform(decoded[0], decoded[1], v);
-    FibletTransform truth = shader::fibletInitialTransform(toVec3(t + 3 * first), toVec3(t + 3 * first + 3), v);
+    FibletTransform truth{};
+    if (options_.mode == EncodeMode::TrueFrame)
+      truth = shader::fibletInitialTransform(toVec3(t + 3 * first), toVec3(t + 3 * first + 3), v);
     for (size_t k = 2; k < count_max; ++k) {
-      const size_t g = first + k;
-      const double seg[3] = {t[3 * g] - t[3 * g - 3], t[3 * g + 1] - t[3 * g - 2], t[3 * g + 2] - t[3 * g - 1]};
-      const double prev[3] = {t[3 * g - 3] - t[3 * g - 6], t[3 * g - 2] - t[3 * g - 5], t[3 * g - 1] - t[3 * g - 4]};
-      const double len = std::sqrt(seg[0] * seg[0] + seg[1] * seg[1] + seg[2] * seg[2]);
-      const double plen = std::sqrt(prev[0] * prev[0] + prev[1] * prev[1] + prev[2] * prev[2]);
-      if (std::fabs(len - delta) > options_.step_tolerance * delta) {
+      const double* here = t + 3 * (first + k);
+      const double seg[3] = {here[0] - here[-3], here[1] - here[-2], here[2] - here[-1]};
+      const double prev[3] = {here[-3] - here[-6], here[-2] - here[-5], here[-1] - here[-4]};
+      const double len2 = seg[0] * seg[0] + seg[1] * seg[1] + seg[2] * seg[2];
+      const double plen2 = prev[0] * prev[0] + prev[1] * prev[1] + prev[2] * prev[2];
+      if (!(len2 >= len2_lo && len2 <= len2_hi)) {  // also catches NaN
         ++report_.step_splits;
         break;
       }
-      // Compare cosines with a little slack so that a turn of exactly alpha
-      // (the largest representable one) is not an exception.
-      const double cos_turn = plen > 0 ? (seg[0] * prev[0] + seg[1] * prev[1] + seg[2] * prev[2]) / (len * plen) : -1.0;
-      if (cos_turn < cos_alpha - 1e-6) {
+      const double turn_dot = seg[0] * prev[0] + seg[1] * prev[1] + seg[2] * prev[2];
+      const double needed = cos_alpha >= 0 ? cos2_alpha * len2 * plen2 : -cos2_alpha * len2 * plen2;
+      const double signed_dot2 = turn_dot >= 0 ? turn_dot * turn_dot : -turn_dot * turn_dot;
+      if (!(plen2 > 0) || signed_dot2 < needed) {
         ++report_.angle_splits;
         break;
       }
       uint32_t code = 0;
-      if (closed) {
-        const double goal[3] = {t[3 * g], t[3 * g + 1], t[3 * g + 2]};
-        const double diff[3] = {goal[0] - w.t.x, goal[1] - w.t.y, goal[2] - w.t.z};
+      if (options_.mode == EncodeMode::ClosedLoop) {
+        // The original point in the decoded frame. The decoded frame is a
+        // rotation (orthonormal to float precision), so the distance of a
+        // candidate's decoded point W * L_c.t to the original point equals
+        // |L_c.t - local|: the search runs in local coordinates.
+        const double diff[3] = {here[0] - w.t.x, here[1] - w.t.y, here[2] - w.t.z};
         const double local[3] = {dot3(w.c0, diff), dot3(w.c1, diff), dot3(w.c2, diff)};
-        const uint32_t centre = encodeDirection(local, alpha);
+        const uint32_t centre = quantizer_.cell(local[0], local[1], local[2]);
         const int ci = int(centre >> 4), cj = int(centre & 15u);
         double best = std::numeric_limits<double>::infinity();
         for (int i = std::max(ci - radius, 0); i <= std::min(ci + radius, 15); ++i) {
           for (int j = std::max(cj - radius, 0); j <= std::min(cj + radius, 15); ++j) {
             const auto candidate = uint32_t(i << 4 | j);
-            // Exactly the translation fibletCompose(w, L) computes.
-            const vec3 p = shader::fibletRotate(w, decoder_.localTransform(candidate).t) + w.t;
-            const double e[3] = {double(p.x) - goal[0], double(p.y) - goal[1], double(p.z) - goal[2]};
+            const auto& p = code_steps_[candidate];
+            const double e[3] = {p[0] - local[0], p[1] - local[1], p[2] - local[2]};
             const double e2 = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
             if (e2 < best) {
               best = e2;
@@ -132,16 +131,17 @@ size_t FibletEncoder::encodeFiblet(size_t first, size_t n, bool begins, EncodedF
           ++report_.error_splits;
           break;
         }
-      } else if (options_.mode == EncodeMode::DecodedFrame) {
+      } else if (options_.mode == EncodeMode::OpenLoop) {
         const double local[3] = {dot3(w.c0, seg), dot3(w.c1, seg), dot3(w.c2, seg)};
         code = encodeDirection(local, alpha);
       } else {
         const double local[3] = {dot3(truth.c0, seg), dot3(truth.c1, seg), dot3(truth.c2, seg)};
         code = encodeDirection(local, alpha);
-        const vec3 exact = toVec3(local) * float(1.0 / len);
+        const vec3 exact = toVec3(local) * float(1.0 / std::sqrt(len2));
         truth = shader::fibletCompose(truth, shader::fibletLocalTransform(exact, v, params_.delta));
       }
       w = shader::fibletCompose(w, decoder_.localTransform(code));
+      if (meter_) measure(w.t, first + k);
       out.bytes[base + shader::fibletCodeByte(uint32_t(k))] = uint8_t(code);
       count = k + 1;
     }

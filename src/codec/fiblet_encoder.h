@@ -3,28 +3,34 @@
 // closed-loop mode that runs the decoder alongside.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 
+#include "codec/codec_error.h"
 #include "codec/codec_params.h"
+#include "codec/direction_quantizer.h"
 #include "codec/fiblet_decoder.h"
 #include "core/tractogram.h"
 
 namespace fibscope {
 
 enum class EncodeMode : uint8_t {
-  // Paper section 3.2: each true direction, in the frame propagated from the
-  // previous true direction, is quantised to the nearest code; the decoded
-  // path drifts as quantisation errors accumulate.
+  // The paper's scheme (section 3.2), `compress --open-loop`: the true
+  // direction of each segment, expressed in the frame the decoder will have
+  // there (propagated from the previously *decoded* directions; the decoder
+  // knows no other), quantised to the nearest code. Heading errors do not
+  // accumulate, position errors do, as a random walk along the fiblet.
   OpenLoop,
-  // Between the two: the true direction of each segment expressed in the
-  // decoder's frame (the encoder tracks the decoded frame but not the
-  // decoded position), so heading errors do not accumulate but position
-  // errors still do, as a random walk.
-  DecodedFrame,
-  // At each point, the code among the (2r+1)^2 cells around the one aimed
-  // from the decoded point and frame at the original point, whose decoded
-  // point lands nearest the original point, so errors do not accumulate.
+  // A naive variant kept to show why the frame must be the decoded one:
+  // directions in the frame of the previous *true* direction. The decoded
+  // path drifts by millimetres (the 16 x 16 grid has no code on the forward
+  // axis, so a straight run is biased the same way at every step).
+  TrueFrame,
+  // The default: at each point, among the (2r+1)^2 cells around the one
+  // aimed from the decoded point and frame at the original point, the code
+  // whose decoded point lands nearest the original point, so errors do not
+  // accumulate.
   ClosedLoop,
 };
 
@@ -59,11 +65,6 @@ struct EncodeReport {
   uint64_t splits() const { return angle_splits + step_splits + error_splits; }
 };
 
-// The nearest code to a local direction (unit, +z forward): the direction
-// is clamped into the alpha-cap, mapped uniformly to the hemisphere
-// (theta' = theta * (pi/2) / alpha) and quantised on the 16 x 16 half-
-// octahedron grid. The inverse of decodeDirection on cell centres.
-uint32_t encodeDirection(const double direction[3], double alpha);
 
 class FibletEncoder {
  public:
@@ -77,6 +78,13 @@ class FibletEncoder {
   void encodeStreamline(const float* xyz, size_t n, EncodedFiblets& out);
   void encode(const Tractogram& chunk, EncodedFiblets& out);
 
+  // Measures every encoded point as the sequential decode reconstructs it
+  // (the encoder runs that decode anyway), in um of world space, into
+  // `meter` (nullptr: off). Non-finite input points are not measured (they
+  // are counted as clamped). The GPU's log-step decode differs from the
+  // sequential one by < 1e-6 of the scene size (tested).
+  void setErrorMeter(CodecErrorMeter* meter) { meter_ = meter; }
+
   const EncodeReport& report() const { return report_; }
   const FibletDecoder& decoder() const { return decoder_; }
 
@@ -88,7 +96,12 @@ class FibletEncoder {
   CodecParams params_;
   EncodeOptions options_;
   FibletDecoder decoder_;
+  FastDirectionQuantizer quantizer_;
+  // The translation of L_c for each code c, in double for the closed-loop search.
+  std::array<std::array<double, 3>, shader::kFibletCodeCount> code_steps_;
   EncodeReport report_;
+  CodecErrorMeter* meter_ = nullptr;
+  double um_per_unit_;  // world micrometres per normalised unit
   std::vector<double> target_;  // the streamline in normalised space
 };
 
