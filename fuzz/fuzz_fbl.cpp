@@ -1,11 +1,18 @@
-// libFuzzer target for the .fbl container reader.
+// libFuzzer target for the .fbl container reader and the fiblet reader on
+// top of it (openFbl).
 //
 // Each input is opened twice: as given, and "repaired", i.e. with the header,
 // section table and section checksums recomputed, so that mutations get past
 // the CRCs and reach the structural checks (offsets, sizes, overlaps, counts).
 // Only fibscope::Error is an accepted outcome. Whatever open() accepts must
 // keep its promises: every section inside the file, 64-byte aligned, in order
-// without overlap, and readable in full.
+// without overlap, and readable in full. A file the container accepts is
+// then decoded streamline by streamline through openFbl (codec parameters,
+// source JSON, dps sections, first-fiblet table and record flags); every
+// chunk must keep the Tractogram invariants and agree with the header.
+//
+// Seeds: fuzz/seeds/fbl.py (container samples) and fuzz/seeds/fbl_fiblets.py
+// (valid fiblet tractograms).
 #include <cstdint>
 #include <cstdlib>
 #include <string>
@@ -13,6 +20,7 @@
 
 #include "codec/fbl_file.h"
 #include "codec/fbl_format.h"
+#include "codec/fbl_reader.h"
 #include "core/byte_order.h"
 #include "core/checksum.h"
 #include "core/error.h"
@@ -21,6 +29,32 @@
 namespace {
 
 namespace fbl = fibscope::fbl;
+
+// Every streamline through openFbl, in small chunks so that chunk
+// boundaries are exercised too.
+void decodeAll(const std::string& path) {
+  try {
+    auto reader = fibscope::openFbl(path);
+    const fibscope::TractogramHeader& h = reader->header();
+    if (h.declared_streamlines < 0 || h.declared_points < 0 || !h.per_point.empty()) std::abort();
+    fibscope::Tractogram chunk;
+    uint64_t streamlines = 0, points = 0;
+    while (reader->read(chunk, 64)) {
+      fibscope::fuzz::checkChunk(*reader, chunk);
+      if (chunk.per_streamline.size() != h.per_streamline.size()) std::abort();
+      for (size_t a = 0; a < chunk.per_streamline.size(); ++a)
+        if (chunk.per_streamline[a].values.size() != chunk.streamlineCount() * h.per_streamline[a].components)
+          std::abort();
+      streamlines += chunk.streamlineCount();
+      points += chunk.pointCount();
+    }
+    // A file read to the end without an error matches its header.
+    if (streamlines != uint64_t(h.declared_streamlines) || points != uint64_t(h.declared_points)) std::abort();
+    if (reader->bytesRead() != h.file_bytes) std::abort();
+  } catch (const fibscope::Error& e) {
+    fibscope::fuzz::checkMessage(e);
+  }
+}
 
 void readAll(const std::string& path) {
   try {
@@ -42,6 +76,7 @@ void readAll(const std::string& path) {
         for (const double v : f.array<double>(s)) sink = sink ^ static_cast<uint8_t>(v == v);
       }
     }
+    decodeAll(path);
   } catch (const fibscope::Error& e) {
     fibscope::fuzz::checkMessage(e);
   }
