@@ -13,5 +13,6 @@ void addInfoCommand(CLI::App& app);
 void addConvertCommand(CLI::App& app);
 void addPhantomCommand(CLI::App& app);
 void addDecompressCommand(CLI::App& app);
+void addCompressCommand(CLI::App& app);
 
 }  // namespace fibscope

@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
   fibscope::addInfoCommand(app);
   fibscope::addConvertCommand(app);
   fibscope::addPhantomCommand(app);
+  fibscope::addCompressCommand(app);
   fibscope::addDecompressCommand(app);
   try {
     app.parse(argc, argv);

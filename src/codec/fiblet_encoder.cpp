@@ -13,6 +13,18 @@ namespace fibscope {
 using shader::FibletTransform;
 using shader::vec3;
 
+void EncodeReport::merge(const EncodeReport& o) {
+  fibers += o.fibers;
+  points += o.points;
+  fiblets += o.fiblets;
+  angle_splits += o.angle_splits;
+  step_splits += o.step_splits;
+  error_splits += o.error_splits;
+  single_point_fibers += o.single_point_fibers;
+  two_point_fibers += o.two_point_fibers;
+  clamped_points += o.clamped_points;
+}
+
 FibletEncoder::FibletEncoder(const CodecParams& params, const EncodeOptions& options)
     : params_(params), options_(options), decoder_(params), quantizer_(params.alpha, params.delta),
       um_per_unit_(1000.0 / double(params.scale)) {
@@ -202,6 +214,18 @@ double pointSegmentDistance(const float* p, const double a[3], const double b[3]
 
 }  // namespace
 
+void ResampleReport::merge(const ResampleReport& other) {
+  const uint64_t measured = measured_points + other.measured_points;
+  if (measured > 0)
+    mean_deviation_mm = (mean_deviation_mm * double(measured_points) +
+                         other.mean_deviation_mm * double(other.measured_points)) / double(measured);
+  measured_points = measured;
+  input_points += other.input_points;
+  output_points += other.output_points;
+  moved_points += other.moved_points;
+  max_deviation_mm = std::max(max_deviation_mm, other.max_deviation_mm);
+}
+
 // More points than a fiber can have in the fiblet tables (uint32 counts).
 constexpr uint64_t kMaxResampledPoints = uint64_t(1) << 31;
 
@@ -287,6 +311,7 @@ Tractogram resampleToStep(const Tractogram& in, double step_mm, ResampleReport* 
   counts.output_points = out.pointCount();
   // Over interior input points only: the first and last are kept exactly.
   counts.mean_deviation_mm = deviation_count ? deviation_sum / double(deviation_count) : 0.0;
+  counts.measured_points = deviation_count;
   if (report) *report = counts;
   return out;
 }

@@ -63,6 +63,8 @@ struct EncodeReport {
   uint64_t clamped_points = 0;  // stored points outside the normalisation box or not finite (clamped to [0,1]^3)
 
   uint64_t splits() const { return angle_splits + step_splits + error_splits; }
+  // Adds the counts of another encoder (one per thread).
+  void merge(const EncodeReport& other);
 };
 
 
@@ -117,6 +119,10 @@ struct ResampleReport {
   // polyline (the chord between the output points around it), in mm.
   double max_deviation_mm = 0;
   double mean_deviation_mm = 0;
+  uint64_t measured_points = 0;  // interior input points behind the mean
+
+  // Adds the counts of another part of the same tractogram.
+  void merge(const ResampleReport& other);
 };
 
 // Resamples every streamline so that consecutive points are step_mm apart
