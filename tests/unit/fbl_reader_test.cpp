@@ -370,6 +370,61 @@ TEST(DecompressCli, trkWithSpaceAndPropertiesComesBackWithTheSameHeader) {
   EXPECT_EQ(decoded.offsets, from_trk.offsets);
 }
 
+// The records and tables of a .fbl as EncodedFiblets, for decodeAll.
+EncodedFiblets encodedFibletsOf(const std::string& path, CodecParams* params) {
+  const FblFile f = FblFile::open(path);
+  *params = codecParamsFromFbl(f.header(), path);
+  EncodedFiblets e;
+  e.record_bytes = params->recordBytes();
+  const auto records = f.data(kFblSectionFiblets);
+  e.bytes.assign(records.begin(), records.end());
+  const auto first = f.array<uint64_t>(*f.find(kFblSectionFiberFirstFiblet));
+  for (size_t i = 0; i + 1 < first.size(); ++i) {
+    e.fiber_first_fiblet.push_back(uint32_t(first[i]));
+    uint32_t points = 0;
+    for (uint64_t k = first[i]; k < first[i + 1]; ++k)
+      points += shader::fibletCount(e.record(k)[shader::fibletFlagsByte(params->points_per_fiblet)]);
+    e.fiber_points.push_back(points);
+  }
+  return e;
+}
+
+TEST(DecompressCli, compressThenDecompressKeepsTheTrkHeaderAndDecodesAsDecodeAll) {
+  TempDir dir;
+  const std::string trk = dir.file("phantom.trk");
+  ASSERT_EQ(test::runFibscope("phantom -n 40 --step 0.5 --threads 1 --seed 5 " + trk).exit_code, 0);
+  const std::string fbl = dir.file("phantom.fbl");
+  const auto c = test::runFibscope("compress --threads 2 --points 32 " + trk + " " + fbl);
+  ASSERT_EQ(c.exit_code, 0) << c.output;
+  CodecParams params;
+  const EncodedFiblets encoded = encodedFibletsOf(fbl, &params);
+  EXPECT_EQ(params.points_per_fiblet, 32u);
+  const Tractogram expected = FibletDecoder(params).decodeAll(encoded);
+  TractogramHeader original;
+  const Tractogram input = readTractogram(trk, &original);
+  EXPECT_EQ(expected.offsets, input.offsets);
+  for (const size_t max_points : {size_t(100), size_t(1) << 20})
+    EXPECT_TRUE(samePoints(readFbl(fbl, max_points), expected)) << max_points;
+
+  const std::string back = dir.file("back.trk");
+  const auto d = test::runFibscope("decompress " + fbl + " " + back);
+  ASSERT_EQ(d.exit_code, 0) << d.output;
+  TractogramHeader header;
+  const Tractogram decoded = readTractogram(back, &header);
+  EXPECT_EQ(decoded.offsets, input.offsets);
+  EXPECT_EQ(header.space.voxel_to_rasmm, original.space.voxel_to_rasmm);
+  EXPECT_EQ(header.space.dimensions, original.space.dimensions);
+  EXPECT_EQ(header.properties, original.properties);
+  ASSERT_EQ(decoded.per_streamline.size(), input.per_streamline.size());
+  for (size_t a = 0; a < decoded.per_streamline.size(); ++a)
+    EXPECT_EQ(decoded.per_streamline[a].values, input.per_streamline[a].values);
+  // trk stores voxel-mm floats: the decoded points come back within float
+  // rounding of a few hundred mm.
+  ASSERT_EQ(decoded.positions.size(), expected.positions.size());
+  for (size_t i = 0; i < expected.positions.size(); ++i)
+    ASSERT_NEAR(decoded.positions[i], expected.positions[i], 1e-4f) << i;
+}
+
 TEST(DecompressCli, tckAndTrxOutputsHoldTheDecodedPoints) {
   TempDir dir;
   const Tractogram t = test::smallTractogram(60, 9, /*with_data=*/true);
