@@ -156,7 +156,10 @@ CompressReport compressTractogram(const ReaderFactory& open_input, const std::st
     fail(header.path, "changed between the two passes of compression");
   std::string directory = std::filesystem::path(output).parent_path().string();
   if (directory.empty()) directory = ".";
-  FblWriter writer(output, fblHeaderFor(params), options.overwrite);
+  // The section table holds exactly the sections written (fiblets, two
+  // fiber tables, the per-fiber arrays, source): on small files a spare
+  // table is a visible part of the bytes per point.
+  FblWriter writer(output, fblHeaderFor(params), options.overwrite, uint32_t(4 + stored_arrays.size()));
   SpillFile first_fiblets(directory, "fiber table");
   SpillFile lengths(directory, "fiber lengths");
   std::vector<SpillFile> arrays;

@@ -27,9 +27,9 @@ uint32_t encodeDirection(const double direction[3], double alpha);
 // with u = sin^2(theta) and k = (pi/2) / alpha the octahedral coordinates
 // are (x, y) * R / (R * (|x| + |y|) + C * |d|), R = sin(k theta) /
 // sin(theta), C = cos(k theta), both even in theta and so smooth in u, read
-// from tables over u. The result is the exact cell or, within 1/16 of a cell
-// of a border, its neighbour (tested): harmless here, since the closed loop
-// searches the neighbouring cells around this one anyway.
+// from tables over u. The result is the exact cell or, within about 1/16 of
+// a cell of a border (a few percent of directions), its neighbour (tested):
+// harmless here, since the closed loop searches the neighbours anyway.
 class FastDirectionQuantizer {
  public:
   FastDirectionQuantizer(double alpha, double step);
