@@ -116,8 +116,10 @@ TractogramHeader headerFromFblSource(std::string_view text, const std::string& f
         array.components = a.at("components").get<uint32_t>();
         array.dtype = a.at("dtype").get<std::string>();
         if (array.components == 0 || array.components > 4096)
-          fail(fbl_path, "section source: array " + array.name + " has " + std::to_string(array.components) +
-                             " components");
+          // The name as a JSON string: escaped, so the message stays one line.
+          fail(fbl_path, "section source: array " +
+                             a.at("name").dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + " has " +
+                             std::to_string(array.components) + " components");
         h.per_streamline.push_back(std::move(array));
       }
   } catch (const nlohmann::json::exception& e) {

@@ -755,6 +755,16 @@ TEST_F(FblTampered, malformedSourceJsonIsNamed) {
   const FblSection& source = sections_.back();
   bytes_[size_t(source.offset)] = '[';
   EXPECT_MESSAGE(errorAfterRepair(), "source");
+
+  // An array named "we\nht" with 0 components: the message stays one line.
+  bytes_ = test::readBytes(good_);
+  std::string json(bytes_.data() + source.offset, size_t(source.bytes));
+  const std::string before = R"({"components":1,"dtype":"float32","name":"weight"})";
+  const std::string after = R"({"components":0,"dtype":"float32","name":"we\nht"})";
+  const size_t at = json.find(before);
+  ASSERT_NE(at, std::string::npos) << json;
+  std::memcpy(bytes_.data() + source.offset + at, after.data(), after.size());
+  EXPECT_MESSAGE(errorAfterRepair(), "source", "0 components");
 }
 
 }  // namespace
