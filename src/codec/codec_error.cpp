@@ -16,7 +16,9 @@ void CodecErrorMeter::add(double distance_um) {
   sum_ += distance_um;
   sum2_ += distance_um * distance_um;
   max_ = std::max(max_, distance_um);
-  const double bin = std::floor(distance_um / kBinUm);
+  // Multiply and truncate (distances are >= 0): std::floor and a division
+  // per point were a fifth of the compressor's time.
+  const double bin = distance_um * (1.0 / kBinUm);
   histogram_[bin < double(kBins - 1) ? size_t(bin) : kBins - 1] += 1;
 }
 

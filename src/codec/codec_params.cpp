@@ -43,70 +43,58 @@ float percentileOf(std::vector<float>& values, double p) {
 void CodecParamEstimator::Sample::push(float value, size_t max_samples) {
   values.push_back(value);
   if (values.size() > std::max<size_t>(max_samples, 2)) {
-    // Keep every other value: the sample stays every-k-th of the stream.
+    // Keep every other value: the sample stays every-k-th of the stream
+    // (the next kept value is one stride after the last kept one).
     size_t kept = 0;
     for (size_t i = 0; i < values.size(); i += 2) values[kept++] = values[i];
+    const bool last_kept = values.size() % 2 == 1;
     values.resize(kept);
+    countdown += last_kept ? stride : 0;
     stride *= 2;
   }
 }
 
 CodecParamEstimator::CodecParamEstimator(const CodecParamOptions& options) : options_(options) {
-  lo_.fill(std::numeric_limits<double>::infinity());
-  hi_.fill(-std::numeric_limits<double>::infinity());
+  lo_f_.fill(std::numeric_limits<float>::infinity());
+  hi_f_.fill(-std::numeric_limits<float>::infinity());
 }
 
-namespace {
-
-double lengthOf(const double d[3]) { return std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]); }
-
-}  // namespace
-
 void CodecParamEstimator::add(const Tractogram& chunk) {
-  // Every point enters the bounding box and every turn the maximum (both
-  // exact); only the sampled lengths and turns cost a sqrt or an acos.
+  // Every point enters the bounding box (exact); only sampled segments are
+  // measured (a sqrt, and an acos for a turn).
+  const float* p = chunk.positions.data();
+  for (size_t i = 0, n = chunk.pointCount(); i < n; ++i, p += 3) {
+    // NaN compares false and stays out of the box.
+    for (int c = 0; c < 3; ++c) {
+      lo_f_[c] = p[c] < lo_f_[c] ? p[c] : lo_f_[c];
+      hi_f_[c] = p[c] > hi_f_[c] ? p[c] : hi_f_[c];
+    }
+  }
   for (size_t s = 0; s < chunk.streamlineCount(); ++s) {
     const size_t first = chunk.offsets[s], n = chunk.pointsIn(s);
-    double prev[3] = {0, 0, 0};
-    bool have_prev = false;  // prev is a finite segment of non-zero length
-    for (size_t i = 0; i < n; ++i) {
-      const float* p = chunk.point(first + i);
-      for (int c = 0; c < 3; ++c) {
-        lo_[c] = std::min(lo_[c], double(p[c]));
-        hi_[c] = std::max(hi_[c], double(p[c]));
-      }
-      if (i == 0) continue;
-      const float* q = p - 3;
-      const double d[3] = {double(p[0]) - q[0], double(p[1]) - q[1], double(p[2]) - q[2]};
-      const double len2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-      if (!std::isfinite(len2)) {  // a NaN or infinite point: no step or turn to measure here
-        have_prev = false;
-        continue;
-      }
+    points_ += n;
+    for (size_t i = 1; i < n; ++i) {
       ++segments_;
-      if (lengths_.takesNext()) lengths_.push(float(std::sqrt(len2)), options_.max_samples);
-      if (len2 > 0 && have_prev) {
-        const double dot = d[0] * prev[0] + d[1] * prev[1] + d[2] * prev[2];
-        const double prev2 = prev[0] * prev[0] + prev[1] * prev[1] + prev[2] * prev[2];
-        const double bound = max_turn_threshold_ * max_turn_threshold_ * len2 * prev2;
-        // cos(turn) < threshold, on squares: a candidate for a new maximum.
-        const bool larger = max_turn_threshold_ >= 0 ? (dot < 0 || dot * dot < bound) : (dot < 0 && dot * dot > bound);
-        const bool sampled = angles_.takesNext();
-        if (larger || sampled) {
-          const double turn = std::acos(std::clamp(dot / (std::sqrt(len2) * lengthOf(prev)), -1.0, 1.0));
-          if (sampled) angles_.push(float(turn), options_.max_samples);
-          if (turn > max_turn_) {
-            max_turn_ = turn;
-            max_turn_threshold_ = std::cos(turn) - 1e-12;
-          }
-        }
-      }
-      if (len2 > 0) {
-        for (int c = 0; c < 3; ++c) prev[c] = d[c];
-        have_prev = true;
+      const bool step = lengths_.takesNext();
+      const bool turn = i >= 2 && angles_.takesNext();
+      if (!step && !turn) continue;
+      const float* b = chunk.point(first + i);
+      const float* a = b - 3;
+      const double d[3] = {double(b[0]) - a[0], double(b[1]) - a[1], double(b[2]) - a[2]};
+      const double len2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+      if (!std::isfinite(len2)) continue;  // a NaN or infinite point: no step or turn here
+      if (step) lengths_.push(float(std::sqrt(len2)), options_.max_samples);
+      if (turn) {
+        const float* z = a - 3;
+        const double e[3] = {double(a[0]) - z[0], double(a[1]) - z[1], double(a[2]) - z[2]};
+        const double prev2 = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
+        if (!(len2 > 0) || !(prev2 > 0) || !std::isfinite(prev2)) continue;
+        const double c = (d[0] * e[0] + d[1] * e[1] + d[2] * e[2]) / std::sqrt(len2 * prev2);
+        const double angle = std::acos(std::clamp(c, -1.0, 1.0));
+        angles_.push(float(angle), options_.max_samples);
+        max_turn_ = std::max(max_turn_, angle);
       }
     }
-    points_ += n;
   }
 }
 
@@ -125,8 +113,12 @@ CodecParamSummary CodecParamEstimator::summary(double step_tolerance) const {
   out.max_turn_deg = max_turn_ * 180.0 / std::numbers::pi;
   CodecParams& params = out.params;
   params.points_per_fiblet = options_.points_per_fiblet;
-  for (int c = 0; c < 3; ++c)
+  std::array<double, 3> lo_, hi_;
+  for (int c = 0; c < 3; ++c) {
+    lo_[c] = lo_f_[c];
+    hi_[c] = hi_f_[c];
     if (!std::isfinite(lo_[c]) || !std::isfinite(hi_[c])) fail(where, "no finite point to normalise");
+  }
   const double extent = std::max({hi_[0] - lo_[0], hi_[1] - lo_[1], hi_[2] - lo_[2]});
   out.extent_mm = extent;
   if (extent > kMaxExtentMm) {

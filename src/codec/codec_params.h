@@ -56,7 +56,7 @@ struct CodecParamSummary {
   uint64_t sampled_steps = 0;  // segment lengths in the sample
   uint64_t sampled_turns = 0;
   double turn_percentile_deg = 0;  // the alpha_percentile-th percentile of the sampled turns
-  double max_turn_deg = 0;         // the largest turn in the whole input (exact)
+  double max_turn_deg = 0;         // the largest sampled turn (compressTractogram puts the exact one here)
   // Fraction of the sampled segments whose length is off delta by more than
   // `step_tolerance` (the encoder's split threshold): resampled or
   // compressed inputs have many.
@@ -93,17 +93,27 @@ class CodecParamEstimator {
     std::vector<float> values;
     uint64_t seen = 0;
     uint64_t stride = 1;
+    uint64_t countdown = 0;  // values to skip before the next kept one
     // Whether the next value is kept (then call push): values that will be
-    // dropped need not be computed.
-    bool takesNext() { return seen++ % stride == 0; }
+    // dropped need not be computed. A countdown, not seen % stride: a 64-bit
+    // division per segment was most of the analysis pass.
+    bool takesNext() {
+      ++seen;
+      if (countdown > 0) {
+        --countdown;
+        return false;
+      }
+      countdown = stride - 1;
+      return true;
+    }
     void push(float value, size_t max_samples);
   };
   CodecParamOptions options_;
   std::array<double, 3> lo_, hi_;
+  std::array<float, 3> lo_f_, hi_f_;  // the box in float (the points are floats: exact)
   uint64_t points_ = 0;
   uint64_t segments_ = 0;
-  double max_turn_ = 0;            // radians
-  double max_turn_threshold_ = 1;  // cos(max_turn_) - tiny: cheaper test for a new maximum
+  double max_turn_ = 0;  // radians, over the sampled turns
   Sample lengths_, angles_;
 };
 

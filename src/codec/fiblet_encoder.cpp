@@ -23,6 +23,21 @@ void EncodeReport::merge(const EncodeReport& o) {
   single_point_fibers += o.single_point_fibers;
   two_point_fibers += o.two_point_fibers;
   clamped_points += o.clamped_points;
+  min_signed_cos2 = std::min(min_signed_cos2, o.min_signed_cos2);
+}
+
+double EncodeReport::maxTurnDegrees() const {
+  const double c = min_signed_cos2 >= 0 ? std::sqrt(min_signed_cos2) : -std::sqrt(-min_signed_cos2);
+  return std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / std::numbers::pi;
+}
+
+void FibletEncoder::noteTurn(size_t j) {
+  const double* p = target_.data() + 3 * j;
+  const double a[3] = {p[0] - p[-3], p[1] - p[-2], p[2] - p[-1]};
+  const double b[3] = {p[3] - p[0], p[4] - p[1], p[5] - p[2]};
+  const double dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+  const double a2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2], b2 = b[0] * b[0] + b[1] * b[1] + b[2] * b[2];
+  if (std::isfinite(dot) && std::isfinite(a2) && std::isfinite(b2)) noteTurn(dot, b2, a2);
 }
 
 FibletEncoder::FibletEncoder(const CodecParams& params, const EncodeOptions& options)
@@ -78,6 +93,11 @@ size_t FibletEncoder::encodeFiblet(size_t first, size_t n, bool begins, EncodedF
     if (first + 1 < n) measure(decoded[1], first + 1);
   }
 
+  // Turns around the join with the previous fiblet, which no fiblet's loop
+  // below measures (for the report's largest turn).
+  if (first >= 2) noteTurn(first - 1);
+  if (first >= 1 && first + 1 < n) noteTurn(first);
+
   const size_t count_max = std::min<size_t>(big_n, n - first);
   size_t count = std::min<size_t>(count_max, 2);
   if (count_max >= 3) {
@@ -105,11 +125,12 @@ size_t FibletEncoder::encodeFiblet(size_t first, size_t n, bool begins, EncodedF
       const double prev[3] = {here[-3] - here[-6], here[-2] - here[-5], here[-1] - here[-4]};
       const double len2 = seg[0] * seg[0] + seg[1] * seg[1] + seg[2] * seg[2];
       const double plen2 = prev[0] * prev[0] + prev[1] * prev[1] + prev[2] * prev[2];
+      const double turn_dot = seg[0] * prev[0] + seg[1] * prev[1] + seg[2] * prev[2];
+      noteTurn(turn_dot, len2, plen2);
       if (!(len2 >= len2_lo && len2 <= len2_hi)) {  // also catches NaN
         ++report_.step_splits;
         break;
       }
-      const double turn_dot = seg[0] * prev[0] + seg[1] * prev[1] + seg[2] * prev[2];
       const double needed = cos_alpha >= 0 ? cos2_alpha * len2 * plen2 : -cos2_alpha * len2 * plen2;
       const double signed_dot2 = turn_dot >= 0 ? turn_dot * turn_dot : -turn_dot * turn_dot;
       if (!(plen2 > 0) || signed_dot2 < needed) {

@@ -61,6 +61,11 @@ struct EncodeReport {
   uint64_t single_point_fibers = 0;
   uint64_t two_point_fibers = 0;
   uint64_t clamped_points = 0;  // stored points outside the normalisation box or not finite (clamped to [0,1]^3)
+  // The largest turn between consecutive segments seen, as the smallest
+  // sign(cos) * cos^2 (no acos per point); maxTurnDegrees() converts.
+  double min_signed_cos2 = 1;
+
+  double maxTurnDegrees() const;
 
   uint64_t splits() const { return angle_splits + step_splits + error_splits; }
   // Adds the counts of another encoder (one per thread).
@@ -94,6 +99,14 @@ class FibletEncoder {
   // Encodes points [first, first + count_max) or fewer (stopping at a split)
   // as one fiblet; returns the number of points it took.
   size_t encodeFiblet(size_t first, size_t n, bool begins, EncodedFiblets& out);
+  // Records the turn at interior point j of the current streamline.
+  void noteTurn(size_t j);
+  // Records a turn given as dot(prev, seg), |seg|^2 and |prev|^2.
+  void noteTurn(double dot, double len2, double prev2) {
+    const double signed_dot2 = dot >= 0 ? dot * dot : -dot * dot;
+    const double bound = report_.min_signed_cos2 * len2 * prev2;
+    if (signed_dot2 < bound && len2 > 0 && prev2 > 0) report_.min_signed_cos2 = signed_dot2 / (len2 * prev2);
+  }
 
   CodecParams params_;
   EncodeOptions options_;

@@ -377,8 +377,9 @@ TEST(SpillFile, readsBackExactlyWhatWasWrittenAcrossBlocks) {
   EXPECT_TRUE(std::filesystem::is_empty(dir.path()));
 }
 
-TEST(FibletParams, largestTurnIsExactWhileTurnsAreSampled) {
-  // A straight fiber with one 40-degree kink among many 2-degree turns.
+TEST(Compressor, largestTurnIsExactWhileAlphaComesFromTheSampledBulk) {
+  // A fiber of alternating 2-degree turns with one 40-degree kink.
+  TempDir dir;
   Tractogram t;
   std::vector<float> xyz;
   double p[3] = {0, 0, 0}, heading = 0;
@@ -389,15 +390,28 @@ TEST(FibletParams, largestTurnIsExactWhileTurnsAreSampled) {
     for (double c : p) xyz.push_back(float(c));
   }
   t.addStreamline(xyz.data(), xyz.size() / 3);
-  CodecParamOptions options;
-  options.max_samples = 100;  // a small sample: the kink is not in it
-  CodecParamEstimator estimator(options);
+  CodecParamOptions sampled;
+  sampled.max_samples = 100;  // a small sample: the kink is not in it
+  CodecParamEstimator estimator(sampled);
   estimator.add(t);
   const CodecParamSummary s = estimator.summary();
   EXPECT_LE(s.sampled_turns, 101u);
-  EXPECT_NEAR(s.max_turn_deg, 40.0, 0.01);
+  EXPECT_LT(s.max_turn_deg, 3.0);
   EXPECT_NEAR(s.turn_percentile_deg, 2.0, 0.05);  // float points 500 mm out: ~0.02 deg of rounding
   EXPECT_NEAR(s.params.deltaMm(), 0.1, 1e-5);
+
+  TractogramHeader header;
+  header.format = "tck";
+  auto writer = createTractogramWriter(dir.file("kink.tck"), header, WriterOptions{});
+  writer->write(t);
+  writer->finish();
+  CompressOptions options = quietOptions();
+  options.params.max_samples = 100;
+  const CompressReport r =
+      compressTractogram([&] { return openTractogram(dir.file("kink.tck")); }, dir.file("k.fbl"), options);
+  EXPECT_NEAR(r.analysis.max_turn_deg, 40.0, 0.05);
+  EXPECT_NEAR(r.analysis.params.alpha / kDeg, 2.2, 0.06);  // 1.1 x the 99.9th percentile
+  EXPECT_EQ(r.encode.angle_splits, 1u);
 }
 
 }  // namespace
