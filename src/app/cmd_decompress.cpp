@@ -33,7 +33,8 @@ void addDecompressCommand(CLI::App& app) {
   cmd->add_flag("--trx-directory", opt->trx_directory, "Write TRX as a directory instead of a zip");
   cmd->callback([opt] {
     if (!isFblPath(opt->input))
-      fail(opt->input, "decompress reads .fbl files (made by `fibscope compress`); use `fibscope convert` for other formats");
+      fail(opt->input,
+           "decompress reads .fbl files (made by `fibscope compress`); use `fibscope convert` for other formats");
     // Refuse before decoding anything: never overwrite silently.
     checkOverwrite(opt->output, opt->force);
     auto reader = openFbl(opt->input);
@@ -58,7 +59,8 @@ void addDecompressCommand(CLI::App& app) {
     for (const auto& w : writer->warnings()) std::fprintf(stderr, "fibscope: warning: %s\n", w.c_str());
     std::printf("wrote %s: %llu streamlines, %llu points (from %s, originally %s)\n", opt->output.c_str(),
                 static_cast<unsigned long long>(streamlines), static_cast<unsigned long long>(points),
-                opt->input.c_str(), reader->header().format.empty() ? "of unknown format" : reader->header().format.c_str());
+                opt->input.c_str(),
+                reader->header().format.empty() ? "of unknown format" : reader->header().format.c_str());
   });
 }
 

@@ -64,23 +64,21 @@ class FblReader final : public TractogramReader {
   FblFile file_;
   CodecParams params_;
   FibletDecoder decoder_;
-  uint32_t n_ = 0;             // points per fiblet
+  uint32_t n_ = 0;  // points per fiblet
   uint32_t record_bytes_ = 0;
   std::span<const uint8_t> records_;
   std::span<const uint64_t> first_fiblet_;   // fiber_count + 1 entries
   std::vector<std::span<const float>> dps_;  // parallel to header_.per_streamline
   uint64_t fiber_count_ = 0;
   uint64_t fiblet_count_ = 0;
-  uint64_t point_count_ = 0;   // the header's
+  uint64_t point_count_ = 0;  // the header's
   uint64_t fiblets_offset_ = 0;
-  uint64_t fiber_ = 0;         // next fiber to read
-  uint64_t points_ = 0;        // decoded so far
+  uint64_t fiber_ = 0;   // next fiber to read
+  uint64_t points_ = 0;  // decoded so far
 };
 
 FblReader::FblReader(const std::string& path)
-    : file_(FblFile::open(path)),
-      params_(codecParamsFromFbl(file_.header(), file_.path())),
-      decoder_(params_) {
+    : file_(FblFile::open(path)), params_(codecParamsFromFbl(file_.header(), file_.path())), decoder_(params_) {
   header_.path = file_.path();
   // Every checksum first: a flipped bit is then reported as corruption of
   // the part it hit, never as whatever structural error it happens to cause
@@ -152,8 +150,7 @@ FblReader::FblReader(const std::string& path)
 const FblSection& FblReader::requireSection(std::string_view name, FblDType dtype) const {
   const FblSection* s = file_.find(name);
   if (!s) fail(header_.path, "no section '" + std::string(name) + "' (a .fbl tractogram needs it)");
-  if (s->dtype != dtype)
-    failIn(name, "holds " + fblDTypeName(s->dtype) + ", expected " + fblDTypeName(dtype));
+  if (s->dtype != dtype) failIn(name, "holds " + fblDTypeName(s->dtype) + ", expected " + fblDTypeName(dtype));
   if (s->components != 1) failIn(name, str(s->components) + " components, expected 1");
   return *s;
 }
@@ -175,7 +172,9 @@ uint64_t FblReader::checkFiber(uint64_t first, uint64_t last) const {
   for (uint64_t i = first; i < last; ++i) {
     const uint32_t flags = records_[i * record_bytes_ + flags_byte];
     const uint32_t count = shader::fibletCount(flags);
-    const auto where = [&] { return "fiblet " + str(i) + " (" + fiber + ", fiblets " + str(first) + ".." + str(last - 1) + "): "; };
+    const auto where = [&] {
+      return "fiblet " + str(i) + " (" + fiber + ", fiblets " + str(first) + ".." + str(last - 1) + "): ";
+    };
     if (count < 1 || count > n_)
       failIn(kFblSectionFiblets, where() + "point count " + str(count) + " outside [1, " + str(n_) + "]");
     const bool begins = (flags & shader::kFibletFlagBegins) != 0;
@@ -189,8 +188,8 @@ uint64_t FblReader::checkFiber(uint64_t first, uint64_t last) const {
     points += count;
   }
   if (points > kFblMaxFiberPoints)
-    failIn(kFblSectionFiblets, fiber + " has " + str(points) + " points, more than the " + str(kFblMaxFiberPoints) +
-                                   " a fiber may have");
+    failIn(kFblSectionFiblets,
+           fiber + " has " + str(points) + " points, more than the " + str(kFblMaxFiberPoints) + " a fiber may have");
   return points;
 }
 
@@ -217,8 +216,8 @@ bool FblReader::read(Tractogram& chunk, size_t max_points) {
     const uint64_t last = first_fiblet_[fiber_ + 1];
     const uint64_t n = checkFiber(first, last);
     if (n > point_count_ - points_)
-      fail(header_.path, "header: " + str(point_count_) + " points, but fibers 0.." + str(fiber_) + " hold " +
-                             str(points_ + n));
+      fail(header_.path,
+           "header: " + str(point_count_) + " points, but fibers 0.." + str(fiber_) + " hold " + str(points_ + n));
     const size_t at = chunk.positions.size();
     chunk.positions.resize(at + 3 * size_t(n));
     decodeFiber(first, last, chunk.positions.data() + at);

@@ -74,8 +74,8 @@ Written writeFbl(const std::string& path, const Tractogram& t, const TractogramH
   for (size_t s = 0; s < t.streamlineCount(); ++s) lengths.push_back(float(arcLength(t, s)));
   writer.writeSection({std::string(kFblSectionFiberLength), FblDType::kFloat32, 1}, lengths.data(), lengths.size() * 4);
   for (const DataArray& a : t.per_streamline)
-    writer.writeSection({std::string(kFblSectionDpsPrefix) + a.name, FblDType::kFloat32, a.components},
-                        a.values.data(), a.values.size() * 4);
+    writer.writeSection({std::string(kFblSectionDpsPrefix) + a.name, FblDType::kFloat32, a.components}, a.values.data(),
+                        a.values.size() * 4);
   const std::string source = fblSourceJson(like);
   writer.writeSection({std::string(kFblSectionSource), FblDType::kUtf8, 1}, source.data(), source.size());
   writer.finish();
@@ -94,7 +94,8 @@ TractogramHeader headerOf(const Tractogram& t, const std::string& format = "tck"
 // Reads everything through a reader, checking every chunk on the way.
 Tractogram readAll(TractogramReader& reader, size_t max_points = size_t(1) << 20, size_t* chunks = nullptr) {
   Tractogram all, chunk;
-  for (const auto& a : reader.header().per_streamline) all.per_streamline.push_back({a.name, a.components, a.dtype, {}});
+  for (const auto& a : reader.header().per_streamline)
+    all.per_streamline.push_back({a.name, a.components, a.dtype, {}});
   uint64_t previous_bytes = reader.bytesRead();
   size_t n = 0;
   while (reader.read(chunk, max_points)) {
@@ -122,7 +123,8 @@ Tractogram readFbl(const std::string& path, size_t max_points = size_t(1) << 20)
   if (std::memcmp(a.positions.data(), b.positions.data(), a.positions.size() * sizeof(float)) != 0) {
     for (size_t i = 0; i < a.positions.size(); ++i)
       if (std::memcmp(&a.positions[i], &b.positions[i], sizeof(float)) != 0)
-        return ::testing::AssertionFailure() << "coordinate " << i << ": " << a.positions[i] << " vs " << b.positions[i];
+        return ::testing::AssertionFailure()
+               << "coordinate " << i << ": " << a.positions[i] << " vs " << b.positions[i];
   }
   return ::testing::AssertionSuccess();
 }
@@ -470,9 +472,10 @@ TEST(DecompressCli, infoShowsCodecFactsSectionsAndTheOriginal) {
   const Written w = writeFbl(fbl, t, like, 20);
   const auto r = test::runFibscope("info " + fbl);
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  for (const std::string& expected : std::vector<std::string>{"fbl container", "N = 20", "delta", "alpha", "bytes per point", "fiblets", "fiber_first_fiblet",
-        "fiber_length_mm", "dps/weight", "source", "CRC ok", "/data/sub-01/brain.trk", "fa (float32)",
-        std::to_string(t.pointCount()) + " points"})
+  for (const std::string& expected :
+       std::vector<std::string>{"fbl container", "N = 20", "delta", "alpha", "bytes per point", "fiblets",
+                                "fiber_first_fiblet", "fiber_length_mm", "dps/weight", "source", "CRC ok",
+                                "/data/sub-01/brain.trk", "fa (float32)", std::to_string(t.pointCount()) + " points"})
     EXPECT_NE(r.output.find(expected), std::string::npos) << expected << "\n" << r.output;
   EXPECT_EQ(r.output.find("BAD"), std::string::npos) << r.output;
 
@@ -647,12 +650,13 @@ class FblTampered : public ::testing::Test {
   size_t fiber_ = 0;
 };
 
-#define EXPECT_MESSAGE(message, ...)                                                        \
-  do {                                                                                      \
-    const std::string m = (message);                                                        \
-    EXPECT_EQ(m.rfind(path_, 0), 0u) << m;                                                  \
-    EXPECT_EQ(m.find('\n'), std::string::npos) << m;                                        \
-    for (const std::string& part : std::initializer_list<std::string>{__VA_ARGS__}) EXPECT_NE(m.find(part), std::string::npos) << part << ": " << m; \
+#define EXPECT_MESSAGE(message, ...)                                                \
+  do {                                                                              \
+    const std::string m = (message);                                                \
+    EXPECT_EQ(m.rfind(path_, 0), 0u) << m;                                          \
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;                                \
+    for (const std::string& part : std::initializer_list<std::string>{__VA_ARGS__}) \
+      EXPECT_NE(m.find(part), std::string::npos) << part << ": " << m;              \
   } while (0)
 
 TEST_F(FblTampered, unchangedFileReadsAfterRepair) { EXPECT_EQ(errorAfterRepair(), ""); }
@@ -679,8 +683,8 @@ TEST_F(FblTampered, tableEndsThatDisagreeWithTheHeaderAreNamed) {
 TEST_F(FblTampered, missingBeginsFlagIsNamed) {
   const uint64_t fiblet = firstFiblet(fiber_);
   *flags(fiblet) &= uint8_t(~shader::kFibletFlagBegins);
-  EXPECT_MESSAGE(errorAfterRepair(), "fiblets", "fiblet " + std::to_string(fiblet),
-                 "fiber " + std::to_string(fiber_), "begins-fiber flag missing");
+  EXPECT_MESSAGE(errorAfterRepair(), "fiblets", "fiblet " + std::to_string(fiblet), "fiber " + std::to_string(fiber_),
+                 "begins-fiber flag missing");
 }
 
 TEST_F(FblTampered, flagsInsideAFiberAreNamed) {
