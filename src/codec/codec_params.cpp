@@ -40,17 +40,17 @@ float percentileOf(std::vector<float>& values, double p) {
   return values[index];
 }
 
-void CodecParamEstimator::Sample::push(float value, size_t max_samples) {
-  values.push_back(value);
-  if (values.size() > std::max<size_t>(max_samples, 2)) {
-    // Keep every other value: the sample stays every-k-th of the stream
-    // (the next kept value is one stride after the last kept one).
+void CodecParamEstimator::push(SegmentSample sample) {
+  samples_.push_back(sample);
+  if (samples_.size() > std::max<size_t>(options_.max_samples, 2)) {
+    // Keep every other sample: still every-k-th of the stream, k doubled.
+    // The next one is 2k after the last kept sample.
     size_t kept = 0;
-    for (size_t i = 0; i < values.size(); i += 2) values[kept++] = values[i];
-    const bool last_kept = values.size() % 2 == 1;
-    values.resize(kept);
-    countdown += last_kept ? stride : 0;
-    stride *= 2;
+    for (size_t i = 0; i < samples_.size(); i += 2) samples_[kept++] = samples_[i];
+    const bool last_kept = samples_.size() % 2 == 1;
+    samples_.resize(kept);
+    if (last_kept) next_sample_ += stride_;
+    stride_ *= 2;
   }
 }
 
@@ -59,9 +59,18 @@ CodecParamEstimator::CodecParamEstimator(const CodecParamOptions& options) : opt
   hi_f_.fill(-std::numeric_limits<float>::infinity());
 }
 
+namespace {
+// The tan^2 key of a turn of 90 degrees or more.
+constexpr double kInfiniteTurn = 1e30;
+// Turn angle in degrees from its tan^2 key.
+double turnDegrees(double tan2) {
+  return tan2 >= kInfiniteTurn ? 90.0 : std::atan(std::sqrt(tan2)) * 180.0 / std::numbers::pi;
+}
+}  // namespace
+
 void CodecParamEstimator::add(const Tractogram& chunk) {
   // Every point enters the bounding box (exact); only sampled segments are
-  // measured (a sqrt, and an acos for a turn).
+  // measured (see SegmentSample).
   const float* p = chunk.positions.data();
   for (size_t i = 0, n = chunk.pointCount(); i < n; ++i, p += 3) {
     // NaN compares false and stays out of the box.
@@ -70,31 +79,38 @@ void CodecParamEstimator::add(const Tractogram& chunk) {
       hi_f_[c] = p[c] > hi_f_[c] ? p[c] : hi_f_[c];
     }
   }
+  const float nan = std::numeric_limits<float>::quiet_NaN();
   for (size_t s = 0; s < chunk.streamlineCount(); ++s) {
     const size_t first = chunk.offsets[s], n = chunk.pointsIn(s);
     points_ += n;
-    for (size_t i = 1; i < n; ++i) {
-      ++segments_;
-      const bool step = lengths_.takesNext();
-      const bool turn = i >= 2 && angles_.takesNext();
-      if (!step && !turn) continue;
+    if (n < 2) continue;
+    // Segments of this streamline are stream indices [segments_, end).
+    const uint64_t end = segments_ + (n - 1);
+    for (; next_sample_ < end; next_sample_ += stride_) {
+      const size_t i = size_t(next_sample_ - segments_) + 1;  // the segment from point i - 1 to i
       const float* b = chunk.point(first + i);
       const float* a = b - 3;
       const double d[3] = {double(b[0]) - a[0], double(b[1]) - a[1], double(b[2]) - a[2]};
       const double len2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-      if (!std::isfinite(len2)) continue;  // a NaN or infinite point: no step or turn here
-      if (step) lengths_.push(float(std::sqrt(len2)), options_.max_samples);
-      if (turn) {
+      SegmentSample sample{std::isfinite(len2) ? float(std::sqrt(len2)) : nan, nan};
+      if (i >= 2 && std::isfinite(len2) && len2 > 0) {
         const float* z = a - 3;
         const double e[3] = {double(a[0]) - z[0], double(a[1]) - z[1], double(a[2]) - z[2]};
         const double prev2 = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
-        if (!(len2 > 0) || !(prev2 > 0) || !std::isfinite(prev2)) continue;
-        const double c = (d[0] * e[0] + d[1] * e[1] + d[2] * e[2]) / std::sqrt(len2 * prev2);
-        const double angle = std::acos(std::clamp(c, -1.0, 1.0));
-        angles_.push(float(angle), options_.max_samples);
-        max_turn_ = std::max(max_turn_, angle);
+        if (prev2 > 0 && std::isfinite(prev2)) {
+          // tan^2 of the turn, |e x d|^2 / (e . d)^2: monotonic in the angle
+          // below 90 degrees (turns beyond count as infinite), exact for
+          // small turns where 1 - cos would cancel, and no acos per sample.
+          // summary() converts the percentile.
+          const double dot = d[0] * e[0] + d[1] * e[1] + d[2] * e[2];
+          const double cx = e[1] * d[2] - e[2] * d[1], cy = e[2] * d[0] - e[0] * d[2], cz = e[0] * d[1] - e[1] * d[0];
+          const double tan2 = dot > 0 ? (cx * cx + cy * cy + cz * cz) / (dot * dot) : kInfiniteTurn;
+          sample.turn = float(std::min(tan2, kInfiniteTurn));
+        }
       }
+      push(sample);
     }
+    segments_ = end;
   }
 }
 
@@ -108,9 +124,13 @@ CodecParamSummary CodecParamEstimator::summary(double step_tolerance) const {
   CodecParamSummary out;
   out.points = points_;
   out.segments = segments_;
-  out.sampled_steps = lengths_.values.size();
-  out.sampled_turns = angles_.values.size();
-  out.max_turn_deg = max_turn_ * 180.0 / std::numbers::pi;
+  std::vector<float> lengths, turns;
+  for (const SegmentSample& sample : samples_) {
+    if (std::isfinite(sample.length) && sample.length > 0) lengths.push_back(sample.length);
+    if (!std::isnan(sample.turn)) turns.push_back(sample.turn);
+  }
+  out.sampled_steps = lengths.size();
+  out.sampled_turns = turns.size();
   CodecParams& params = out.params;
   params.points_per_fiblet = options_.points_per_fiblet;
   std::array<double, 3> lo_, hi_;
@@ -137,8 +157,6 @@ CodecParamSummary CodecParamEstimator::summary(double step_tolerance) const {
   double delta_mm = options_.delta_mm;
   out.delta_measured = !(delta_mm > 0);
   if (out.delta_measured) {
-    std::vector<float> lengths = lengths_.values;
-    std::erase_if(lengths, [](float l) { return !(l > 0); });
     if (lengths.empty()) fail(where, "no segment of non-zero length to measure the step from");
     delta_mm = percentileOf(lengths, 50.0);
   }
@@ -148,17 +166,17 @@ CodecParamSummary CodecParamEstimator::summary(double step_tolerance) const {
     fail(where, "step " + std::to_string(delta_mm) + " mm is too small for points spanning " + std::to_string(extent) +
                     " mm (float precision)");
   params.delta = float(delta_mm * double(params.scale));
-  if (!lengths_.values.empty()) {
+  if (!lengths.empty()) {
     uint64_t off = 0;
-    for (float l : lengths_.values) off += std::fabs(double(l) - delta_mm) > step_tolerance * delta_mm;
-    out.steps_off_fraction = double(off) / double(lengths_.values.size());
+    for (float l : lengths) off += std::fabs(double(l) - delta_mm) > step_tolerance * delta_mm;
+    out.steps_off_fraction = double(off) / double(lengths.size());
   }
 
   double alpha_deg = options_.alpha_deg;
   out.alpha_measured = !(alpha_deg > 0);
-  if (!angles_.values.empty()) {
-    std::vector<float> angles = angles_.values;
-    out.turn_percentile_deg = double(percentileOf(angles, options_.alpha_percentile)) * 180.0 / std::numbers::pi;
+  if (!turns.empty()) {
+    out.max_turn_deg = turnDegrees(*std::max_element(turns.begin(), turns.end()));
+    out.turn_percentile_deg = turnDegrees(percentileOf(turns, options_.alpha_percentile));
   }
   if (out.alpha_measured) alpha_deg = out.turn_percentile_deg * options_.alpha_margin;
   alpha_deg = std::clamp(alpha_deg, options_.min_alpha_deg, std::min(options_.max_alpha_deg, 90.0));

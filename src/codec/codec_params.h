@@ -89,32 +89,22 @@ class CodecParamEstimator {
   CodecParamSummary summary(double step_tolerance = 0.05) const;
 
  private:
-  struct Sample {
-    std::vector<float> values;
-    uint64_t seen = 0;
-    uint64_t stride = 1;
-    uint64_t countdown = 0;  // values to skip before the next kept one
-    // Whether the next value is kept (then call push): values that will be
-    // dropped need not be computed. A countdown, not seen % stride: a 64-bit
-    // division per segment was most of the analysis pass.
-    bool takesNext() {
-      ++seen;
-      if (countdown > 0) {
-        --countdown;
-        return false;
-      }
-      countdown = stride - 1;
-      return true;
-    }
-    void push(float value, size_t max_samples);
+  // A deterministic sample of the segments: every stride-th segment of the
+  // stream (in stream order), stride doubling whenever the sample outgrows
+  // max_samples. Segments between samples are skipped without a look.
+  struct SegmentSample {
+    float length;  // mm; NaN when not finite
+    float turn;    // tan^2 of the turn into this segment (see add()); NaN when none
   };
+  void push(SegmentSample sample);
   CodecParamOptions options_;
   std::array<double, 3> lo_, hi_;
   std::array<float, 3> lo_f_, hi_f_;  // the box in float (the points are floats: exact)
   uint64_t points_ = 0;
   uint64_t segments_ = 0;
-  double max_turn_ = 0;  // radians, over the sampled turns
-  Sample lengths_, angles_;
+  std::vector<SegmentSample> samples_;
+  uint64_t stride_ = 1;
+  uint64_t next_sample_ = 0;  // stream index of the next sampled segment
 };
 
 // chooseCodecParams(t) = an estimator fed with the whole of t.

@@ -110,6 +110,7 @@ CompressReport compressTractogram(const ReaderFactory& open_input, const std::st
     Progress progress("analysing", double(report.input_bytes), "bytes", options.terminal_progress,
                       options.progress_sink);
     Tractogram chunk;
+    chunk.positions.reserve(3 * (options.chunk_points + options.chunk_points / 4));
     while (reader->read(chunk, options.chunk_points)) {
       estimator.add(chunk);
       progress.set(double(reader->bytesRead()));
@@ -218,6 +219,8 @@ CompressReport compressTractogram(const ReaderFactory& open_input, const std::st
       std::shared_ptr<ChunkJob> job;
       if (spare.empty()) {
         job = std::make_shared<ChunkJob>();
+        // A chunk ends with a whole streamline, a little past chunk_points.
+        job->input.positions.reserve(3 * (options.chunk_points + options.chunk_points / 4));
       } else {
         job = std::move(spare.back());
         spare.pop_back();

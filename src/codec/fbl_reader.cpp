@@ -42,7 +42,7 @@ std::string str(uint64_t v) { return std::to_string(v); }
 
 class FblReader final : public TractogramReader {
  public:
-  explicit FblReader(const std::string& path);
+  FblReader(const std::string& path, DecodeOrder order);
 
   bool read(Tractogram& chunk, size_t max_points) override;
   uint64_t bytesRead() const override {
@@ -64,6 +64,7 @@ class FblReader final : public TractogramReader {
   FblFile file_;
   CodecParams params_;
   FibletDecoder decoder_;
+  DecodeOrder order_;
   uint32_t n_ = 0;  // points per fiblet
   uint32_t record_bytes_ = 0;
   std::span<const uint8_t> records_;
@@ -77,8 +78,11 @@ class FblReader final : public TractogramReader {
   uint64_t points_ = 0;  // decoded so far
 };
 
-FblReader::FblReader(const std::string& path)
-    : file_(FblFile::open(path)), params_(codecParamsFromFbl(file_.header(), file_.path())), decoder_(params_) {
+FblReader::FblReader(const std::string& path, DecodeOrder order)
+    : file_(FblFile::open(path)),
+      params_(codecParamsFromFbl(file_.header(), file_.path())),
+      decoder_(params_),
+      order_(order) {
   header_.path = file_.path();
   // Every checksum first: a flipped bit is then reported as corruption of
   // the part it hit, never as whatever structural error it happens to cause
@@ -196,8 +200,8 @@ uint64_t FblReader::checkFiber(uint64_t first, uint64_t last) const {
 void FblReader::decodeFiber(uint64_t first, uint64_t last, float* out) const {
   std::array<float, 3 * shader::kFibletMaxPoints> xyz;
   for (uint64_t i = first; i < last; ++i) {
-    // checkFiber validated the count, so decodeScan returns it (never 0).
-    const uint32_t count = decoder_.decodeScan(records_.data() + i * record_bytes_, xyz.data());
+    // checkFiber validated the count, so decode returns it (never 0).
+    const uint32_t count = decoder_.decode(records_.data() + i * record_bytes_, xyz.data(), order_);
     for (uint32_t k = 0; k < count; ++k) {
       // As FibletDecoder::decodeAll: world mm in double, rounded to float.
       const auto w = decoder_.toWorld(&xyz[3 * k]);
@@ -238,6 +242,8 @@ bool FblReader::read(Tractogram& chunk, size_t max_points) {
 
 }  // namespace
 
-std::unique_ptr<TractogramReader> openFbl(const std::string& path) { return std::make_unique<FblReader>(path); }
+std::unique_ptr<TractogramReader> openFbl(const std::string& path, DecodeOrder order) {
+  return std::make_unique<FblReader>(path, order);
+}
 
 }  // namespace fibscope

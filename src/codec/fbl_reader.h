@@ -6,6 +6,7 @@
 #include <memory>
 #include <string>
 
+#include "codec/fiblet_decoder.h"
 #include "io/reader.h"
 
 namespace fibscope {
@@ -25,10 +26,11 @@ inline constexpr uint64_t kFblMaxFiberPoints = uint64_t(1) << 24;
 // size, declared_streamlines / declared_points = the header's fiber and
 // point counts. No per-point arrays (fiblets carry positions only).
 //
-// read() decodes whole fibers, about max_points points a chunk, with
-// FibletDecoder::decodeScan (the GPU's order) and toWorld rounded to float,
-// so the points equal FibletDecoder::decodeAll of the same records bit for
-// bit whatever the chunk size. Memory is bounded by the chunk (the records
+// read() decodes whole fibers, about max_points points a chunk, in `order`
+// (by default Sequential: the points the compression report measured, and
+// 5x cheaper than the GPU's Scan order) and toWorld rounded to float, so the
+// points equal FibletDecoder::decodeAll(records, order) bit for bit
+// whatever the chunk size. Memory is bounded by the chunk (the records
 // stay in the read-only map).
 //
 // Safe on untrusted files. On open: the container checks (FblFile::open),
@@ -40,6 +42,6 @@ inline constexpr uint64_t kFblMaxFiberPoints = uint64_t(1) << 24;
 // after the last fiber, the header's point count equals the points decoded.
 // Every problem is a one-line Error naming the path and the section, fiber
 // or fiblet index. bytesRead() advances with the fiblets consumed.
-std::unique_ptr<TractogramReader> openFbl(const std::string& path);
+std::unique_ptr<TractogramReader> openFbl(const std::string& path, DecodeOrder order = DecodeOrder::Sequential);
 
 }  // namespace fibscope

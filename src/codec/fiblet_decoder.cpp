@@ -76,6 +76,7 @@ std::string validateFiblets(const EncodedFiblets& f, const CodecParams& params) 
 
 FibletDecoder::FibletDecoder(const CodecParams& params) : params_(params) {
   validateCodecParams(params);
+  mm_per_unit_ = 1.0 / double(params.scale);
   v_ = vec3(params.v[0], params.v[1], params.v[2]);
   table_ = buildDirectionTable(params.alpha);
   for (uint32_t code = 0; code < shader::kFibletCodeCount; ++code) {
@@ -142,13 +143,7 @@ uint32_t FibletDecoder::decodeScan(const uint8_t* record, float* xyz) const {
   return count;
 }
 
-std::array<double, 3> FibletDecoder::toWorld(const float* p) const {
-  std::array<double, 3> w;
-  for (int c = 0; c < 3; ++c) w[c] = double(p[c]) / double(params_.scale) + double(params_.translation[c]);
-  return w;
-}
-
-Tractogram FibletDecoder::decodeAll(const EncodedFiblets& fiblets) const {
+Tractogram FibletDecoder::decodeAll(const EncodedFiblets& fiblets, DecodeOrder order) const {
   if (const std::string problem = validateFiblets(fiblets, params_); !problem.empty())
     fail("fiblets", problem);
   Tractogram out;
@@ -157,7 +152,7 @@ Tractogram FibletDecoder::decodeAll(const EncodedFiblets& fiblets) const {
   std::array<float, 3 * shader::kFibletMaxPoints> xyz;
   for (size_t i = 0; i < fiblets.fibletCount(); ++i) {
     const uint8_t* record = fiblets.record(i);
-    const uint32_t count = decodeScan(record, xyz.data());
+    const uint32_t count = decode(record, xyz.data(), order);
     for (uint32_t k = 0; k < count; ++k) {
       const auto w = toWorld(&xyz[3 * k]);
       for (int c = 0; c < 3; ++c) out.positions.push_back(float(w[c]));

@@ -1,6 +1,7 @@
 #include "codec/fiblet_encoder.h"
 
 #include <algorithm>
+#include <cstring>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -31,6 +32,58 @@ double EncodeReport::maxTurnDegrees() const {
   return std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / std::numbers::pi;
 }
 
+float FibletEncoder::searchAround(uint32_t centre, float lx, float ly, float lz, uint32_t& code) const {
+  const int ci = int(centre >> 4), cj = int(centre & 15u), radius = options_.search_radius;
+  // Squared distance of candidate c's step to the local goal, in float; the
+  // vector path below does the same operations lane by lane, so both paths
+  // pick the same code (the first smallest in row-major order).
+  const auto distance2 = [&](uint32_t c) {
+    const float ex = step_x_[c] - lx, ey = step_y_[c] - ly, ez = step_z_[c] - lz;
+    return ex * ex + ey * ey + ez * ez;
+  };
+  if (radius == 1 && ci >= 1 && ci <= 14 && cj >= 1 && cj <= 14) {
+    // The 3 x 3 block as three rows of four lanes (the fourth ignored).
+    float e2[12];
+    for (int row = 0; row < 3; ++row) {
+      const size_t at = size_t(((ci - 1 + row) << 4) + cj - 1);
+      V4f x, y, z;
+      std::memcpy(&x, &step_x_[at], sizeof x);
+      std::memcpy(&y, &step_y_[at], sizeof y);
+      std::memcpy(&z, &step_z_[at], sizeof z);
+      const V4f ex = x - splat4(lx), ey = y - splat4(ly), ez = z - splat4(lz);
+      const V4f d2 = ex * ex + ey * ey + ez * ez;
+      std::memcpy(&e2[4 * row], &d2, sizeof d2);
+    }
+    // The first smallest by a tournament on (value, index) pairs held in
+    // registers: each left operand precedes its right one in row-major
+    // order and wins ties. (A running argmin reloading e2[pick] made a
+    // serial chain of loads that cost more than the distances.)
+    struct Candidate {
+      float e2;
+      int index;
+    };
+    const auto better = [](Candidate a, Candidate b) { return b.e2 < a.e2 ? b : a; };
+    const auto at = [&](int c) { return Candidate{e2[c], c}; };
+    const Candidate top = better(better(better(at(0), at(1)), better(at(2), at(4))),
+                                 better(better(at(5), at(6)), better(at(8), at(9))));
+    const Candidate pick = better(top, at(10));
+    code = uint32_t(((ci - 1 + pick.index / 4) << 4) + cj - 1 + pick.index % 4);
+    return pick.e2;
+  }
+  float best = std::numeric_limits<float>::infinity();
+  for (int i = std::max(ci - radius, 0); i <= std::min(ci + radius, 15); ++i) {
+    for (int j = std::max(cj - radius, 0); j <= std::min(cj + radius, 15); ++j) {
+      const auto candidate = uint32_t(i << 4 | j);
+      const float e2 = distance2(candidate);
+      if (e2 < best) {
+        best = e2;
+        code = candidate;
+      }
+    }
+  }
+  return best;
+}
+
 void FibletEncoder::noteTurn(size_t j) {
   const double* p = target_.data() + 3 * j;
   const double a[3] = {p[0] - p[-3], p[1] - p[-2], p[2] - p[-1]};
@@ -44,15 +97,22 @@ FibletEncoder::FibletEncoder(const CodecParams& params, const EncodeOptions& opt
     : params_(params), options_(options), decoder_(params), quantizer_(params.alpha, params.delta),
       um_per_unit_(1000.0 / double(params.scale)) {
   if (options.search_radius < 0 || options.search_radius > 15) fail("fiblet encoder", "search radius outside [0, 15]");
+  step_x_.fill(0);
+  step_y_.fill(0);
+  step_z_.fill(0);
   for (uint32_t c = 0; c < shader::kFibletCodeCount; ++c) {
     const vec3& step = decoder_.localTransform(c).t;
-    code_steps_[c] = {double(step.x), double(step.y), double(step.z)};
+    step_x_[c] = step.x;
+    step_y_[c] = step.y;
+    step_z_[c] = step.z;
+    local4_[c] = toFrame4(decoder_.localTransform(c));
   }
 }
 
 namespace {
 
 double dot3(const vec3& a, const double b[3]) { return double(a.x) * b[0] + double(a.y) * b[1] + double(a.z) * b[2]; }
+double dot3(V4f a, const double b[3]) { return double(a[0]) * b[0] + double(a[1]) * b[1] + double(a[2]) * b[2]; }
 
 vec3 toVec3(const double* p) { return vec3(float(p[0]), float(p[1]), float(p[2])); }
 
@@ -115,7 +175,9 @@ size_t FibletEncoder::encodeFiblet(size_t first, size_t n, bool begins, EncodedF
     const double max_error2 = std::pow(options_.max_point_error * delta, 2);
     const int radius = options_.search_radius;
     // The decoder's frame, and (true-frame variant) the frame of the true directions.
-    FibletTransform w = shader::fibletInitialTransform(decoded[0], decoded[1], v);
+    // The decoder's frame (Frame4: bit-identical to fibletCompose, faster),
+    // and (true-frame variant) the frame of the true directions.
+    Frame4 w = toFrame4(shader::fibletInitialTransform(decoded[0], decoded[1], v));
     FibletTransform truth{};
     if (options_.mode == EncodeMode::TrueFrame)
       truth = shader::fibletInitialTransform(toVec3(t + 3 * first), toVec3(t + 3 * first + 3), v);
@@ -143,24 +205,11 @@ size_t FibletEncoder::encodeFiblet(size_t first, size_t n, bool begins, EncodedF
         // rotation (orthonormal to float precision), so the distance of a
         // candidate's decoded point W * L_c.t to the original point equals
         // |L_c.t - local|: the search runs in local coordinates.
-        const double diff[3] = {here[0] - w.t.x, here[1] - w.t.y, here[2] - w.t.z};
+        const double diff[3] = {here[0] - w.t[0], here[1] - w.t[1], here[2] - w.t[2]};
         const double local[3] = {dot3(w.c0, diff), dot3(w.c1, diff), dot3(w.c2, diff)};
         const uint32_t centre = quantizer_.cell(local[0], local[1], local[2]);
-        const int ci = int(centre >> 4), cj = int(centre & 15u);
-        double best = std::numeric_limits<double>::infinity();
-        for (int i = std::max(ci - radius, 0); i <= std::min(ci + radius, 15); ++i) {
-          for (int j = std::max(cj - radius, 0); j <= std::min(cj + radius, 15); ++j) {
-            const auto candidate = uint32_t(i << 4 | j);
-            const auto& p = code_steps_[candidate];
-            const double e[3] = {p[0] - local[0], p[1] - local[1], p[2] - local[2]};
-            const double e2 = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
-            if (e2 < best) {
-              best = e2;
-              code = candidate;
-            }
-          }
-        }
-        if (best > max_error2) {
+        const float best = searchAround(centre, float(local[0]), float(local[1]), float(local[2]), code);
+        if (double(best) > max_error2) {
           ++report_.error_splits;
           break;
         }
@@ -173,8 +222,8 @@ size_t FibletEncoder::encodeFiblet(size_t first, size_t n, bool begins, EncodedF
         const vec3 exact = toVec3(local) * float(1.0 / std::sqrt(len2));
         truth = shader::fibletCompose(truth, shader::fibletLocalTransform(exact, v, params_.delta));
       }
-      w = shader::fibletCompose(w, decoder_.localTransform(code));
-      if (meter_) measure(w.t, first + k);
+      w = compose4(w, local4_[code]);
+      if (meter_) measure(toVec3(w.t), first + k);
       out.bytes[base + shader::fibletCodeByte(uint32_t(k))] = uint8_t(code);
       count = k + 1;
     }

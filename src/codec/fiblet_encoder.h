@@ -11,6 +11,7 @@
 #include "codec/codec_params.h"
 #include "codec/direction_quantizer.h"
 #include "codec/fiblet_decoder.h"
+#include "codec/fiblet_simd.h"
 #include "core/tractogram.h"
 
 namespace fibscope {
@@ -112,8 +113,13 @@ class FibletEncoder {
   EncodeOptions options_;
   FibletDecoder decoder_;
   FastDirectionQuantizer quantizer_;
-  // The translation of L_c for each code c, in double for the closed-loop search.
-  std::array<std::array<double, 3>, shader::kFibletCodeCount> code_steps_;
+  // Closed loop: the code among the cells around `centre` whose step lands
+  // nearest the local goal (l); returns the squared distance.
+  float searchAround(uint32_t centre, float lx, float ly, float lz, uint32_t& code) const;
+  // The translation of L_c for each code c as three arrays (padded so that
+  // four-lane loads at any cell stay inside), and L_c as Frame4.
+  std::array<float, shader::kFibletCodeCount + 4> step_x_, step_y_, step_z_;
+  std::array<Frame4, shader::kFibletCodeCount> local4_;
   EncodeReport report_;
   CodecErrorMeter* meter_ = nullptr;
   double um_per_unit_;  // world micrometres per normalised unit

@@ -3,7 +3,7 @@
 // Files are written the way `fibscope compress` writes them (FblWriter +
 // encodeTractogram, sections fiblets, fiber_first_fiblet, fiber_length_mm,
 // dps/<name>, source); the reference for the decoded points is
-// FibletDecoder::decodeAll of the same records. Damage is tested two ways:
+// FibletDecoder::decodeAll of the same records (in the reader's order). Damage is tested two ways:
 // raw bit flips and truncations (caught by the container's checksums and
 // sizes), and tables tampered with and their checksums recomputed, so that
 // the reader's own structural checks are what must catch them.
@@ -180,20 +180,30 @@ TEST(FblReader, pointsEqualDecodeAllBitForBitWhateverTheChunkSize) {
   TractogramHeader header;
   const Tractogram& t = phantomFibers(&header);
   const Written w = writeFbl(path, t, header);
-  const Tractogram expected = FibletDecoder(w.params).decodeAll(w.fiblets);
-  ASSERT_EQ(expected.streamlineCount(), t.streamlineCount());
-  for (const size_t max_points : {size_t(1), size_t(97), size_t(1000), size_t(4096), size_t(1) << 20}) {
-    auto reader = openFbl(path);
-    size_t chunks = 0;
-    const Tractogram got = readAll(*reader, max_points, &chunks);
-    EXPECT_EQ(reader->bytesRead(), reader->header().file_bytes);
-    EXPECT_TRUE(samePoints(got, expected)) << "max_points " << max_points;
-    if (max_points == 1) {
-      EXPECT_EQ(chunks, t.streamlineCount());
-    } else if (max_points == (size_t(1) << 20)) {
-      EXPECT_EQ(chunks, 1u);
+  for (const DecodeOrder order : {DecodeOrder::Sequential, DecodeOrder::Scan}) {
+    const Tractogram expected = FibletDecoder(w.params).decodeAll(w.fiblets, order);
+    ASSERT_EQ(expected.streamlineCount(), t.streamlineCount());
+    for (const size_t max_points : {size_t(1), size_t(97), size_t(1000), size_t(4096), size_t(1) << 20}) {
+      auto reader = openFbl(path, order);
+      size_t chunks = 0;
+      const Tractogram got = readAll(*reader, max_points, &chunks);
+      EXPECT_EQ(reader->bytesRead(), reader->header().file_bytes);
+      EXPECT_TRUE(samePoints(got, expected)) << "max_points " << max_points;
+      if (max_points == 1) {
+        EXPECT_EQ(chunks, t.streamlineCount());
+      } else if (max_points == (size_t(1) << 20)) {
+        EXPECT_EQ(chunks, 1u);
+      }
     }
   }
+  // The two orders agree to 1e-6 of the scene size, not bit for bit.
+  const Tractogram seq = FibletDecoder(w.params).decodeAll(w.fiblets, DecodeOrder::Sequential);
+  const Tractogram scan = FibletDecoder(w.params).decodeAll(w.fiblets, DecodeOrder::Scan);
+  ASSERT_EQ(seq.positions.size(), scan.positions.size());
+  double worst = 0;
+  for (size_t i = 0; i < seq.positions.size(); ++i)
+    worst = std::max(worst, std::fabs(double(seq.positions[i]) - scan.positions[i]));
+  EXPECT_LE(worst, 1e-6 / double(w.params.scale));
 }
 
 TEST(FblReader, chunksHoldWholeFibersAndAboutMaxPoints) {
@@ -229,7 +239,8 @@ TEST(FblReader, smallerFibletsAndEmptyAndOnePointFibersDecodeAsEncoded) {
   for (const uint32_t n : {8u, 20u, 60u}) {
     const std::string path = dir.file("n" + std::to_string(n) + ".fbl");
     const Written w = writeFbl(path, t, headerOf(t), n);
-    EXPECT_TRUE(samePoints(readFbl(path, 50), FibletDecoder(w.params).decodeAll(w.fiblets))) << "N = " << n;
+    EXPECT_TRUE(samePoints(readFbl(path, 50), FibletDecoder(w.params).decodeAll(w.fiblets, DecodeOrder::Sequential)))
+        << "N = " << n;
   }
 }
 
@@ -401,7 +412,7 @@ TEST(DecompressCli, compressThenDecompressKeepsTheTrkHeaderAndDecodesAsDecodeAll
   CodecParams params;
   const EncodedFiblets encoded = encodedFibletsOf(fbl, &params);
   EXPECT_EQ(params.points_per_fiblet, 32u);
-  const Tractogram expected = FibletDecoder(params).decodeAll(encoded);
+  const Tractogram expected = FibletDecoder(params).decodeAll(encoded, DecodeOrder::Sequential);
   TractogramHeader original;
   const Tractogram input = readTractogram(trk, &original);
   EXPECT_EQ(expected.offsets, input.offsets);
