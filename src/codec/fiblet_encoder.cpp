@@ -54,21 +54,22 @@ float FibletEncoder::searchAround(uint32_t centre, float lx, float ly, float lz,
       const V4f d2 = ex * ex + ey * ey + ez * ez;
       std::memcpy(&e2[4 * row], &d2, sizeof d2);
     }
-    // The first smallest by a tournament on (value, index) pairs held in
-    // registers: each left operand precedes its right one in row-major
-    // order and wins ties. (A running argmin reloading e2[pick] made a
-    // serial chain of loads that cost more than the distances.)
-    struct Candidate {
-      float e2;
-      int index;
+    // The first smallest without branches (its position is data, so
+    // branches mispredict): distances are >= 0, so their bits order as
+    // integers, and (bits << 4 | position) orders by distance, then by
+    // row-major position; a tree of integer minimums (cmov) picks it.
+    const auto key = [&](int c) {
+      uint32_t bits;
+      std::memcpy(&bits, &e2[c], sizeof bits);
+      return uint64_t(bits) << 4 | uint64_t(c);
     };
-    const auto better = [](Candidate a, Candidate b) { return b.e2 < a.e2 ? b : a; };
-    const auto at = [&](int c) { return Candidate{e2[c], c}; };
-    const Candidate top = better(better(better(at(0), at(1)), better(at(2), at(4))),
-                                 better(better(at(5), at(6)), better(at(8), at(9))));
-    const Candidate pick = better(top, at(10));
-    code = uint32_t(((ci - 1 + pick.index / 4) << 4) + cj - 1 + pick.index % 4);
-    return pick.e2;
+    const auto least = [](uint64_t a, uint64_t b) { return b < a ? b : a; };
+    const uint64_t top = least(least(least(key(0), key(1)), least(key(2), key(4))),
+                               least(least(key(5), key(6)), least(key(8), key(9))));
+    const uint64_t pick = least(top, key(10));
+    const int index = int(pick & 15u);
+    code = uint32_t(((ci - 1 + index / 4) << 4) + cj - 1 + index % 4);
+    return e2[index];
   }
   float best = std::numeric_limits<float>::infinity();
   for (int i = std::max(ci - radius, 0); i <= std::min(ci + radius, 15); ++i) {
@@ -84,8 +85,8 @@ float FibletEncoder::searchAround(uint32_t centre, float lx, float ly, float lz,
   return best;
 }
 
-void FibletEncoder::noteTurn(size_t j) {
-  const double* p = target_.data() + 3 * j;
+void FibletEncoder::noteTurn(const Lane& lane, size_t j) {
+  const double* p = lane.target.data() + 3 * j;
   const double a[3] = {p[0] - p[-3], p[1] - p[-2], p[2] - p[-1]};
   const double b[3] = {p[3] - p[0], p[4] - p[1], p[5] - p[2]};
   const double dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
@@ -96,6 +97,15 @@ void FibletEncoder::noteTurn(size_t j) {
 FibletEncoder::FibletEncoder(const CodecParams& params, const EncodeOptions& options)
     : params_(params), options_(options), decoder_(params), quantizer_(params.alpha, params.delta),
       um_per_unit_(1000.0 / double(params.scale)) {
+  v_ = vec3(params.v[0], params.v[1], params.v[2]);
+  const double delta = params.delta;
+  len2_lo_ = std::pow((1 - options.step_tolerance) * delta, 2);
+  len2_hi_ = std::pow((1 + options.step_tolerance) * delta, 2);
+  // A little slack so that a turn of exactly alpha (the largest
+  // representable one) is not an exception.
+  cos_alpha_ = std::cos(double(params.alpha)) - 1e-6;
+  cos2_alpha_ = cos_alpha_ * cos_alpha_;
+  max_error2_ = std::pow(options.max_point_error * delta, 2);
   if (options.search_radius < 0 || options.search_radius > 15) fail("fiblet encoder", "search radius outside [0, 15]");
   step_x_.fill(0);
   step_y_.fill(0);
@@ -118,11 +128,35 @@ vec3 toVec3(const double* p) { return vec3(float(p[0]), float(p[1]), float(p[2])
 
 }  // namespace
 
-size_t FibletEncoder::encodeFiblet(size_t first, size_t n, bool begins, EncodedFiblets& out) {
-  const uint32_t big_n = params_.points_per_fiblet;
-  const size_t base = out.bytes.size();
-  out.bytes.resize(base + params_.recordBytes(), 0);
-  const double* t = target_.data();
+void FibletEncoder::startFiber(Lane& lane, const float* xyz, size_t n) {
+  if (n > std::numeric_limits<uint32_t>::max()) fail("fiblet encoder", "more than 2^32 points in one fiber");
+  ++report_.fibers;
+  report_.points += n;
+  if (n == 1) ++report_.single_point_fibers;
+  if (n == 2) ++report_.two_point_fibers;
+  lane.target.resize(3 * n);
+  for (size_t i = 0; i < 3 * n; ++i)
+    lane.target[i] = (double(xyz[i]) - double(params_.translation[i % 3])) * double(params_.scale);
+  lane.n = n;
+  lane.first = 0;
+  lane.fiber_offset = lane.bytes.size();
+  lane.fiber_fiblets = 0;
+  lane.active = n > 0;  // an empty fiber has no fiblet
+  if (n > 0) startFiblet(lane);
+}
+
+void FibletEncoder::measure(const Lane& lane, V4f p, size_t index) {
+  const double* o = lane.target.data() + 3 * index;
+  const double e2 = (double(p[0]) - o[0]) * (double(p[0]) - o[0]) + (double(p[1]) - o[1]) * (double(p[1]) - o[1]) +
+                    (double(p[2]) - o[2]) * (double(p[2]) - o[2]);
+  if (std::isfinite(e2)) meter_->add(std::sqrt(e2) * um_per_unit_);
+}
+
+void FibletEncoder::startFiblet(Lane& lane) {
+  const size_t first = lane.first, n = lane.n;
+  lane.base = lane.bytes.size();
+  lane.bytes.resize(lane.base + params_.recordBytes(), 0);
+  const double* t = lane.target.data();
 
   // Points 0 and 1, quantised to 16 bits per coordinate.
   vec3 decoded[2];
@@ -135,127 +169,168 @@ size_t FibletEncoder::encodeFiblet(size_t first, size_t n, bool begins, EncodedF
       if (!inside && axis == 0 && (which == 0 || first + 1 < n)) ++report_.clamped_points;
       const uint32_t q = inside ? uint32_t(std::nearbyint(std::clamp(scaled, 0.0, double(shader::kFibletQuantMax))))
                                 : (scaled > 0 ? shader::kFibletQuantMax : 0u);
-      out.bytes[base + 6 * size_t(which) + 2 * size_t(axis)] = uint8_t(q);
-      out.bytes[base + 6 * size_t(which) + 2 * size_t(axis) + 1] = uint8_t(q >> 8);
+      lane.bytes[lane.base + 6 * size_t(which) + 2 * size_t(axis)] = uint8_t(q);
+      lane.bytes[lane.base + 6 * size_t(which) + 2 * size_t(axis) + 1] = uint8_t(q >> 8);
       c[axis] = shader::fibletDequantize(q);
     }
     decoded[which] = vec3(c[0], c[1], c[2]);
   }
-  // Measures decoded point `p` against target point `index`.
-  const auto measure = [&](const vec3& p, size_t index) {
-    const double* o = t + 3 * index;
-    const double e2 = (double(p.x) - o[0]) * (double(p.x) - o[0]) + (double(p.y) - o[1]) * (double(p.y) - o[1]) +
-                      (double(p.z) - o[2]) * (double(p.z) - o[2]);
-    if (std::isfinite(e2)) meter_->add(std::sqrt(e2) * um_per_unit_);
-  };
   if (meter_) {
-    measure(decoded[0], first);
-    if (first + 1 < n) measure(decoded[1], first + 1);
+    measure(lane, toV4f(decoded[0]), first);
+    if (first + 1 < n) measure(lane, toV4f(decoded[1]), first + 1);
   }
+  // Turns around the join with the previous fiblet, which no fiblet's steps
+  // measure (for the report's largest turn).
+  if (first >= 2) noteTurn(lane, first - 1);
+  if (first >= 1 && first + 1 < n) noteTurn(lane, first);
 
-  // Turns around the join with the previous fiblet, which no fiblet's loop
-  // below measures (for the report's largest turn).
-  if (first >= 2) noteTurn(first - 1);
-  if (first >= 1 && first + 1 < n) noteTurn(first);
-
-  const size_t count_max = std::min<size_t>(big_n, n - first);
-  size_t count = std::min<size_t>(count_max, 2);
-  if (count_max >= 3) {
-    const vec3 v(params_.v[0], params_.v[1], params_.v[2]);
-    const double delta = params_.delta;
-    const double alpha = params_.alpha;
-    // Step and turn checks on squared quantities (no sqrt or division per
-    // point): |len - delta| <= tol * delta and cos(turn) >= cos(alpha), the
-    // latter with a little slack so that a turn of exactly alpha (the
-    // largest representable one) is not an exception.
-    const double len2_lo = std::pow((1 - options_.step_tolerance) * delta, 2);
-    const double len2_hi = std::pow((1 + options_.step_tolerance) * delta, 2);
-    const double cos_alpha = std::cos(alpha) - 1e-6;
-    const double cos2_alpha = cos_alpha * cos_alpha;
-    const double max_error2 = std::pow(options_.max_point_error * delta, 2);
-    const int radius = options_.search_radius;
-    // The decoder's frame, and (true-frame variant) the frame of the true directions.
+  lane.count_max = std::min<size_t>(params_.points_per_fiblet, n - first);
+  lane.count = std::min<size_t>(lane.count_max, 2);
+  lane.k = 2;
+  if (lane.count_max >= 3) {
     // The decoder's frame (Frame4: bit-identical to fibletCompose, faster),
     // and (true-frame variant) the frame of the true directions.
-    Frame4 w = toFrame4(shader::fibletInitialTransform(decoded[0], decoded[1], v));
-    FibletTransform truth{};
+    lane.w = toFrame4(shader::fibletInitialTransform(decoded[0], decoded[1], v_));
     if (options_.mode == EncodeMode::TrueFrame)
-      truth = shader::fibletInitialTransform(toVec3(t + 3 * first), toVec3(t + 3 * first + 3), v);
-    for (size_t k = 2; k < count_max; ++k) {
-      const double* here = t + 3 * (first + k);
-      const double seg[3] = {here[0] - here[-3], here[1] - here[-2], here[2] - here[-1]};
-      const double prev[3] = {here[-3] - here[-6], here[-2] - here[-5], here[-1] - here[-4]};
-      const double len2 = seg[0] * seg[0] + seg[1] * seg[1] + seg[2] * seg[2];
-      const double plen2 = prev[0] * prev[0] + prev[1] * prev[1] + prev[2] * prev[2];
-      const double turn_dot = seg[0] * prev[0] + seg[1] * prev[1] + seg[2] * prev[2];
-      noteTurn(turn_dot, len2, plen2);
-      if (!(len2 >= len2_lo && len2 <= len2_hi)) {  // also catches NaN
-        ++report_.step_splits;
-        break;
-      }
-      const double needed = cos_alpha >= 0 ? cos2_alpha * len2 * plen2 : -cos2_alpha * len2 * plen2;
-      const double signed_dot2 = turn_dot >= 0 ? turn_dot * turn_dot : -turn_dot * turn_dot;
-      if (!(plen2 > 0) || signed_dot2 < needed) {
-        ++report_.angle_splits;
-        break;
-      }
-      uint32_t code = 0;
-      if (options_.mode == EncodeMode::ClosedLoop) {
-        // The original point in the decoded frame. The decoded frame is a
-        // rotation (orthonormal to float precision), so the distance of a
-        // candidate's decoded point W * L_c.t to the original point equals
-        // |L_c.t - local|: the search runs in local coordinates.
-        const double diff[3] = {here[0] - w.t[0], here[1] - w.t[1], here[2] - w.t[2]};
-        const double local[3] = {dot3(w.c0, diff), dot3(w.c1, diff), dot3(w.c2, diff)};
-        const uint32_t centre = quantizer_.cell(local[0], local[1], local[2]);
-        const float best = searchAround(centre, float(local[0]), float(local[1]), float(local[2]), code);
-        if (double(best) > max_error2) {
-          ++report_.error_splits;
-          break;
-        }
-      } else if (options_.mode == EncodeMode::OpenLoop) {
-        const double local[3] = {dot3(w.c0, seg), dot3(w.c1, seg), dot3(w.c2, seg)};
-        code = encodeDirection(local, alpha);
-      } else {
-        const double local[3] = {dot3(truth.c0, seg), dot3(truth.c1, seg), dot3(truth.c2, seg)};
-        code = encodeDirection(local, alpha);
-        const vec3 exact = toVec3(local) * float(1.0 / std::sqrt(len2));
-        truth = shader::fibletCompose(truth, shader::fibletLocalTransform(exact, v, params_.delta));
-      }
-      w = compose4(w, local4_[code]);
-      if (meter_) measure(toVec3(w.t), first + k);
-      out.bytes[base + shader::fibletCodeByte(uint32_t(k))] = uint8_t(code);
-      count = k + 1;
-    }
+      lane.truth = shader::fibletInitialTransform(toVec3(t + 3 * first), toVec3(t + 3 * first + 3), v_);
   }
-  const bool ends = first + count == n;
-  out.bytes[base + shader::fibletFlagsByte(big_n)] = uint8_t(shader::fibletFlags(begins, ends, uint32_t(count)));
+}
+
+bool FibletEncoder::stepFiblet(Lane& lane) {
+  const size_t k = lane.k;
+  if (k >= lane.count_max) return false;
+  const double* here = lane.target.data() + 3 * (lane.first + k);
+  const double seg[3] = {here[0] - here[-3], here[1] - here[-2], here[2] - here[-1]};
+  const double prev[3] = {here[-3] - here[-6], here[-2] - here[-5], here[-1] - here[-4]};
+  const double len2 = seg[0] * seg[0] + seg[1] * seg[1] + seg[2] * seg[2];
+  const double plen2 = prev[0] * prev[0] + prev[1] * prev[1] + prev[2] * prev[2];
+  const double turn_dot = seg[0] * prev[0] + seg[1] * prev[1] + seg[2] * prev[2];
+  noteTurn(turn_dot, len2, plen2);
+  // Step and turn checks on squared quantities (no sqrt or division per
+  // point): |len - delta| <= tol * delta and cos(turn) >= cos(alpha).
+  if (!(len2 >= len2_lo_ && len2 <= len2_hi_)) {  // also catches NaN
+    ++report_.step_splits;
+    return false;
+  }
+  const double needed = cos_alpha_ >= 0 ? cos2_alpha_ * len2 * plen2 : -cos2_alpha_ * len2 * plen2;
+  const double signed_dot2 = turn_dot >= 0 ? turn_dot * turn_dot : -turn_dot * turn_dot;
+  if (!(plen2 > 0) || signed_dot2 < needed) {
+    ++report_.angle_splits;
+    return false;
+  }
+  Frame4& w = lane.w;
+  uint32_t code = 0;
+  if (options_.mode == EncodeMode::ClosedLoop) {
+    // The original point in the decoded frame. The decoded frame is a
+    // rotation (orthonormal to float precision), so the distance of a
+    // candidate's decoded point W * L_c.t to the original point equals
+    // |L_c.t - local|: the search runs in local coordinates.
+    const double diff[3] = {here[0] - w.t[0], here[1] - w.t[1], here[2] - w.t[2]};
+    const double local[3] = {dot3(w.c0, diff), dot3(w.c1, diff), dot3(w.c2, diff)};
+    const uint32_t centre = quantizer_.cell(local[0], local[1], local[2]);
+    const float best = searchAround(centre, float(local[0]), float(local[1]), float(local[2]), code);
+    if (double(best) > max_error2_) {
+      ++report_.error_splits;
+      return false;
+    }
+  } else if (options_.mode == EncodeMode::OpenLoop) {
+    const double local[3] = {dot3(w.c0, seg), dot3(w.c1, seg), dot3(w.c2, seg)};
+    code = encodeDirection(local, params_.alpha);
+  } else {
+    const double local[3] = {dot3(lane.truth.c0, seg), dot3(lane.truth.c1, seg), dot3(lane.truth.c2, seg)};
+    code = encodeDirection(local, params_.alpha);
+    const vec3 exact = toVec3(local) * float(1.0 / std::sqrt(len2));
+    lane.truth = shader::fibletCompose(lane.truth, shader::fibletLocalTransform(exact, v_, params_.delta));
+  }
+  w = compose4(w, local4_[code]);
+  if (meter_) measure(lane, w.t, lane.first + k);
+  lane.bytes[lane.base + shader::fibletCodeByte(uint32_t(k))] = uint8_t(code);
+  lane.count = k + 1;
+  lane.k = k + 1;
+  return true;
+}
+
+bool FibletEncoder::finishFiblet(Lane& lane) {
+  const bool begins = lane.first == 0;
+  const bool ends = lane.first + lane.count == lane.n;
+  lane.bytes[lane.base + shader::fibletFlagsByte(params_.points_per_fiblet)] =
+      uint8_t(shader::fibletFlags(begins, ends, uint32_t(lane.count)));
   ++report_.fiblets;
-  return count;
+  ++lane.fiber_fiblets;
+  lane.first += lane.count;
+  if (ends) return false;
+  startFiblet(lane);
+  return true;
+}
+
+void FibletEncoder::emit(const Lane& lane, size_t offset, uint32_t fiblets, uint32_t points, EncodedFiblets& out) {
+  const uint64_t first_fiblet = out.fiblet_base + out.fibletCount();
+  if (first_fiblet + fiblets > std::numeric_limits<uint32_t>::max())
+    fail("fiblet encoder", "more than 2^32 fiblets in one encoded block");
+  out.fiber_first_fiblet.push_back(uint32_t(first_fiblet));
+  out.fiber_points.push_back(points);
+  const uint8_t* from = lane.bytes.data() + offset;
+  out.bytes.insert(out.bytes.end(), from, from + size_t(fiblets) * params_.recordBytes());
+}
+
+void FibletEncoder::checkOutput(EncodedFiblets& out) const {
+  if (out.record_bytes == 0) out.record_bytes = params_.recordBytes();
+  if (out.record_bytes != params_.recordBytes()) fail("fiblet encoder", "output holds records of another size");
 }
 
 void FibletEncoder::encodeStreamline(const float* xyz, size_t n, EncodedFiblets& out) {
-  if (out.record_bytes == 0) out.record_bytes = params_.recordBytes();
-  if (out.record_bytes != params_.recordBytes()) fail("fiblet encoder", "output holds records of another size");
-  const uint64_t first_fiblet = out.fiblet_base + out.fibletCount();
-  if (first_fiblet + (n + 1) > std::numeric_limits<uint32_t>::max() || n > std::numeric_limits<uint32_t>::max())
-    fail("fiblet encoder", "more than 2^32 fiblets or points in one fiber");
-  out.fiber_first_fiblet.push_back(uint32_t(first_fiblet));
-  out.fiber_points.push_back(uint32_t(n));
-  ++report_.fibers;
-  report_.points += n;
-  if (n == 1) ++report_.single_point_fibers;
-  if (n == 2) ++report_.two_point_fibers;
-
-  target_.resize(3 * n);
-  for (size_t i = 0; i < 3 * n; ++i)
-    target_[i] = (double(xyz[i]) - double(params_.translation[i % 3])) * double(params_.scale);
-  for (size_t first = 0; first < n;) first += encodeFiblet(first, n, first == 0, out);
+  checkOutput(out);
+  Lane& lane = lanes_[0];
+  lane.bytes.clear();
+  startFiber(lane, xyz, n);
+  if (n > 0) {
+    do {
+      while (stepFiblet(lane)) {
+      }
+    } while (finishFiblet(lane));
+  }
+  emit(lane, lane.fiber_offset, lane.fiber_fiblets, uint32_t(n), out);
 }
 
 void FibletEncoder::encode(const Tractogram& chunk, EncodedFiblets& out) {
-  for (size_t s = 0; s < chunk.streamlineCount(); ++s)
-    encodeStreamline(chunk.point(chunk.offsets[s]), chunk.pointsIn(s), out);
+  checkOutput(out);
+  // Two fibers at a time, a point of each in turn: each point depends on
+  // the previous one through the decoded frame (a chain of ~100 cycles of
+  // latency), and the two chains overlap in the out-of-order core. Fibers
+  // are placed in the lanes' buffers as they finish and copied out in input
+  // order, so the output is the same as one fiber after the other.
+  const size_t fibers = chunk.streamlineCount();
+  placements_.resize(fibers);
+  for (Lane& lane : lanes_) lane.bytes.clear();
+  size_t next = 0;
+  const auto startNext = [&](size_t l) {
+    Lane& lane = lanes_[l];
+    lane.active = false;
+    while (!lane.active && next < fibers) {
+      lane.fiber = next;
+      startFiber(lane, chunk.point(chunk.offsets[next]), chunk.pointsIn(next));
+      if (!lane.active) placements_[next] = {uint8_t(l), lane.fiber_offset, 0};  // empty: no fiblet
+      ++next;
+    }
+  };
+  const auto advance = [&](size_t l) {
+    Lane& lane = lanes_[l];
+    if (stepFiblet(lane) || finishFiblet(lane)) return;
+    placements_[lane.fiber] = {uint8_t(l), lane.fiber_offset, lane.fiber_fiblets};
+    startNext(l);
+  };
+  startNext(0);
+  startNext(1);
+  while (lanes_[0].active && lanes_[1].active) {
+    advance(0);
+    advance(1);
+  }
+  for (size_t l = 0; l < 2; ++l)
+    while (lanes_[l].active) advance(l);
+  for (size_t s = 0; s < fibers; ++s) {
+    const Placement& p = placements_[s];
+    emit(lanes_[p.lane], p.offset, p.fiblets, uint32_t(chunk.pointsIn(s)), out);
+  }
 }
 
 EncodedFiblets encodeTractogram(const Tractogram& tractogram, const CodecParams& params, const EncodeOptions& options,

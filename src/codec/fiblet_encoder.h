@@ -97,11 +97,39 @@ class FibletEncoder {
   const FibletDecoder& decoder() const { return decoder_; }
 
  private:
-  // Encodes points [first, first + count_max) or fewer (stopping at a split)
-  // as one fiblet; returns the number of points it took.
-  size_t encodeFiblet(size_t first, size_t n, bool begins, EncodedFiblets& out);
-  // Records the turn at interior point j of the current streamline.
-  void noteTurn(size_t j);
+  // One fiber being encoded, a fiblet at a time; encode() runs two at once.
+  struct Lane {
+    std::vector<double> target;  // the fiber in normalised space
+    std::vector<uint8_t> bytes;  // records of the fibers this lane encoded
+    size_t fiber = 0, n = 0;     // which fiber of the chunk, its point count
+    size_t fiber_offset = 0;     // where its records start in bytes
+    uint32_t fiber_fiblets = 0;
+    // The fiblet in progress: points [first, first + count), the next point
+    // k, at most count_max points; its record at bytes[base].
+    size_t first = 0, k = 0, count = 0, count_max = 0, base = 0;
+    Frame4 w;                               // the decoder's frame after point k - 1
+    shader::FibletTransform truth{};        // TrueFrame mode only
+    bool active = false;
+  };
+  struct Placement {
+    uint8_t lane = 0;
+    size_t offset = 0;
+    uint32_t fiblets = 0;
+  };
+  void startFiber(Lane& lane, const float* xyz, size_t n);
+  // Writes points 0 and 1 of a fiblet starting at lane.first.
+  void startFiblet(Lane& lane);
+  // Encodes point lane.k; false when the fiblet is complete (full, the
+  // fiber's end, or an exception that starts a new fiblet at lane.k).
+  bool stepFiblet(Lane& lane);
+  // Writes the flags; starts the next fiblet and returns true, or returns
+  // false at the end of the fiber.
+  bool finishFiblet(Lane& lane);
+  void emit(const Lane& lane, size_t offset, uint32_t fiblets, uint32_t points, EncodedFiblets& out);
+  void checkOutput(EncodedFiblets& out) const;
+  void measure(const Lane& lane, V4f decoded, size_t index);
+  // Records the turn at interior point j of the lane's fiber.
+  void noteTurn(const Lane& lane, size_t j);
   // Records a turn given as dot(prev, seg), |seg|^2 and |prev|^2.
   void noteTurn(double dot, double len2, double prev2) {
     const double signed_dot2 = dot >= 0 ? dot * dot : -dot * dot;
@@ -123,7 +151,12 @@ class FibletEncoder {
   EncodeReport report_;
   CodecErrorMeter* meter_ = nullptr;
   double um_per_unit_;  // world micrometres per normalised unit
-  std::vector<double> target_;  // the streamline in normalised space
+  shader::vec3 v_;
+  double len2_lo_, len2_hi_;     // accepted squared step lengths (step_tolerance)
+  double cos_alpha_, cos2_alpha_;
+  double max_error2_;            // closed loop: squared max_point_error
+  Lane lanes_[2];
+  std::vector<Placement> placements_;
 };
 
 // Encodes a whole tractogram; `report` (optional) receives the counts.
