@@ -14,5 +14,6 @@ void addConvertCommand(CLI::App& app);
 void addPhantomCommand(CLI::App& app);
 void addDecompressCommand(CLI::App& app);
 void addCompressCommand(CLI::App& app);
+void addGpuInfoCommand(CLI::App& app);
 
 }  // namespace fibscope

@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   fibscope::addPhantomCommand(app);
   fibscope::addCompressCommand(app);
   fibscope::addDecompressCommand(app);
+  fibscope::addGpuInfoCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -1,0 +1,119 @@
+#include "gpu/vulkan_context.h"
+
+#include <algorithm>
+#include <cctype>
+
+#include "gpu/vk_check.h"
+
+namespace fibscope::gpu {
+
+namespace {
+
+int typeRank(VkPhysicalDeviceType type) {
+  switch (type) {
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+      return 0;
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+      return 1;
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+      return 2;
+    case VK_PHYSICAL_DEVICE_TYPE_CPU:
+      return 3;
+    default:
+      return 4;
+  }
+}
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return s;
+}
+
+std::string deviceList(std::span<const DeviceInfo> devices, bool with_missing) {
+  std::string list;
+  for (const DeviceInfo& d : devices) {
+    if (!list.empty()) list += "; ";
+    list += d.name;
+    if (with_missing && !d.missing.empty()) list += ": " + d.missing;
+  }
+  return list.empty() ? "none" : list;
+}
+
+}  // namespace
+
+const DeviceInfo& chooseDevice(std::span<const DeviceInfo> devices, const std::string& name) {
+  if (!name.empty()) {
+    const std::string wanted = lower(name);
+    for (const DeviceInfo& d : devices) {
+      if (lower(d.name).find(wanted) == std::string::npos) continue;
+      if (!d.missing.empty()) throw Error("vulkan: device " + d.name + " cannot run fibscope: " + d.missing);
+      return d;
+    }
+    throw Error("vulkan: no device name contains \"" + name + "\" (devices: " + deviceList(devices, false) + ")");
+  }
+  const DeviceInfo* best = nullptr;
+  for (const DeviceInfo& d : devices)
+    if (d.missing.empty() && (!best || typeRank(d.type) < typeRank(best->type))) best = &d;
+  if (!best) throw VulkanUnavailable("vulkan: no device can run fibscope (" + deviceList(devices, true) + ")");
+  return *best;
+}
+
+VulkanContext::VulkanContext(const ContextOptions& options)
+    : instance_(options.instance), info_(chooseDevice(instance_.devices(), options.device_name)) {
+  vkGetPhysicalDeviceMemoryProperties(info_.handle, &memory_);
+  VkPhysicalDeviceProperties properties;
+  vkGetPhysicalDeviceProperties(info_.handle, &properties);
+  limits_ = properties.limits;
+
+  // Only what the passes use: buffer device addresses for every buffer (no
+  // descriptor sets for data), 64-bit integers and atomics for the
+  // visibility buffer, synchronization2 barriers.
+  VkPhysicalDeviceVulkan13Features features13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+  features13.synchronization2 = VK_TRUE;
+  // glslc's Vulkan 1.3 SPIR-V declares workgroup sizes with LocalSizeId,
+  // which needs maintenance4 (a feature every 1.3 device has).
+  features13.maintenance4 = VK_TRUE;
+  VkPhysicalDeviceVulkan12Features features12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+  features12.pNext = &features13;
+  features12.bufferDeviceAddress = VK_TRUE;
+  features12.shaderBufferInt64Atomics = VK_TRUE;
+  VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+  features.pNext = &features12;
+  features.features.shaderInt64 = VK_TRUE;
+
+  const float priority = 1.0f;
+  VkDeviceQueueCreateInfo queue_info{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+  queue_info.queueFamilyIndex = uint32_t(info_.queue_family);
+  queue_info.queueCount = 1;
+  queue_info.pQueuePriorities = &priority;
+
+  VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+  info.pNext = &features;
+  info.queueCreateInfoCount = 1;
+  info.pQueueCreateInfos = &queue_info;
+  throwIfFailed(vkCreateDevice(info_.handle, &info, nullptr, &device_), "vkCreateDevice on " + info_.name);
+  vkGetDeviceQueue(device_, queueFamily(), 0, &queue_);
+
+  VkCommandPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pool_info.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT | VK_COMMAND_POOL_CREATE_TRANSIENT_BIT;
+  pool_info.queueFamilyIndex = queueFamily();
+  const VkResult r = vkCreateCommandPool(device_, &pool_info, nullptr, &command_pool_);
+  if (r != VK_SUCCESS) {
+    release();
+    throwIfFailed(r, "vkCreateCommandPool");
+  }
+}
+
+VulkanContext::~VulkanContext() { release(); }
+
+void VulkanContext::release() {
+  if (device_ != VK_NULL_HANDLE) {
+    vkDeviceWaitIdle(device_);
+    if (command_pool_ != VK_NULL_HANDLE) vkDestroyCommandPool(device_, command_pool_, nullptr);
+    vkDestroyDevice(device_, nullptr);
+  }
+  command_pool_ = VK_NULL_HANDLE;
+  device_ = VK_NULL_HANDLE;
+}
+
+}  // namespace fibscope::gpu
