@@ -8,6 +8,12 @@
 //                        GPU's log-step prefix (log2(59) = 6 compose rounds
 //                        over all lanes, so more work than sequential)
 //   CodecMeasureError    decode + world-space comparison (codec_error)
+//   CodecEncodeThreads/T closed-loop encode of chunks of 200 fibers on T
+//                        threads (the compressor's pool), wall-clock rate
+//   FblDecompressToPoints/order  an .fbl of the phantom read back through
+//                        openFbl into world-space float points (checksums,
+//                        table checks, decode, toWorld): what `decompress`
+//                        does before writing; order 0 sequential, 1 scan
 #include <benchmark/benchmark.h>
 
 #include <array>
@@ -15,7 +21,10 @@
 #include "codec/codec_error.h"
 #include "codec/codec_params.h"
 #include "codec/fiblet_decoder.h"
+#include "codec/compressor.h"
+#include "codec/fbl_reader.h"
 #include "codec/fiblet_encoder.h"
+#include "core/thread_pool.h"
 #include "phantom/phantom.h"
 
 namespace fibscope {
@@ -83,6 +92,67 @@ void CodecMeasureError(benchmark::State& state) {
   state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(t.pointCount()));
 }
 BENCHMARK(CodecMeasureError)->Unit(benchmark::kMillisecond);
+
+void CodecEncodeThreads(benchmark::State& state) {
+  const Tractogram& t = benchPhantom();
+  const CodecParams params = chooseCodecParams(t);
+  const auto threads = unsigned(state.range(0));
+  // Chunks of 200 fibers, as the compressor hands them out.
+  std::vector<Tractogram> chunks;
+  for (size_t s = 0; s < t.streamlineCount(); s += 200) {
+    Tractogram c;
+    for (size_t i = s; i < std::min(s + 200, t.streamlineCount()); ++i) c.addStreamline(t.point(t.offsets[i]), t.pointsIn(i));
+    chunks.push_back(std::move(c));
+  }
+  std::vector<std::unique_ptr<FibletEncoder>> encoders;
+  for (unsigned w = 0; w < threads; ++w) encoders.push_back(std::make_unique<FibletEncoder>(params));
+  std::vector<EncodedFiblets> out(chunks.size());
+  ThreadPool pool(threads);
+  for (auto _ : state) {
+    std::vector<std::future<void>> done;
+    for (size_t c = 0; c < chunks.size(); ++c)
+      done.push_back(pool.submit([&, c](unsigned w) {
+        out[c].bytes.clear();
+        out[c].fiber_first_fiblet.clear();
+        out[c].fiber_points.clear();
+        encoders[w]->encode(chunks[c], out[c]);
+      }));
+    for (auto& d : done) d.get();
+  }
+  state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(t.pointCount()));
+}
+BENCHMARK(CodecEncodeThreads)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+
+void FblDecompressToPoints(benchmark::State& state) {
+  static const std::string path = [] {
+    const std::string p = std::string(std::getenv("TMPDIR") ? std::getenv("TMPDIR") : "/tmp") + "/fibscope_codec_bench.fbl";
+    CompressOptions options;
+    options.terminal_progress = false;
+    options.overwrite = true;
+    compressTractogram(
+        [] {
+          PhantomOptions o;
+          o.streamlines = 2000;
+          o.seed = 3;
+          return openPhantom(o);
+        },
+        p, options);
+    return p;
+  }();
+  const DecodeOrder order = state.range(0) ? DecodeOrder::Scan : DecodeOrder::Sequential;
+  uint64_t points = 0;
+  Tractogram chunk;
+  for (auto _ : state) {
+    auto reader = openFbl(path, order);
+    while (reader->read(chunk)) {
+      points += chunk.pointCount();
+      benchmark::DoNotOptimize(chunk.positions.data());
+    }
+  }
+  state.SetItemsProcessed(int64_t(points));
+  state.SetLabel(order == DecodeOrder::Scan ? "scan" : "sequential");
+}
+BENCHMARK(FblDecompressToPoints)->ArgName("scan")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace fibscope

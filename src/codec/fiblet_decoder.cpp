@@ -82,6 +82,7 @@ FibletDecoder::FibletDecoder(const CodecParams& params) : params_(params) {
   for (uint32_t code = 0; code < shader::kFibletCodeCount; ++code) {
     const shader::vec4& d = table_[code];
     local_[code] = shader::fibletLocalTransform(vec3(d.x, d.y, d.z), v_, params.delta);
+    local4_[code] = toFrame4(local_[code]);
   }
 }
 
@@ -113,10 +114,12 @@ uint32_t FibletDecoder::decodeSequential(const uint8_t* record, float* xyz) cons
   if (count == 1) return 1;
   const vec3 p1 = recordPoint(record, 1);
   store(xyz, 1, p1);
-  FibletTransform w = shader::fibletInitialTransform(p0, p1, v_);
+  // Frame4: the operations of fibletCompose lane by lane (bit-identical,
+  // tested), about twice as fast as scalar vec3s.
+  Frame4 w = toFrame4(shader::fibletInitialTransform(p0, p1, v_));
   for (uint32_t k = 2; k < count; ++k) {
-    w = shader::fibletCompose(w, local_[record[shader::fibletCodeByte(k)]]);
-    store(xyz, k, w.t);
+    w = compose4(w, local4_[record[shader::fibletCodeByte(k)]]);
+    store(xyz, k, toVec3(w.t));
   }
   return count;
 }
@@ -130,16 +133,16 @@ uint32_t FibletDecoder::decodeScan(const uint8_t* record, float* xyz) const {
   if (count == 1) return 1;
   // Lane i holds W_1 (i = 0) or L_{i+1}; one lane per point 1..count-1.
   const uint32_t lanes = count - 1;
-  std::array<FibletTransform, shader::kFibletMaxPoints> lane, previous;
-  lane[0] = shader::fibletInitialTransform(p0, recordPoint(record, 1), v_);
-  for (uint32_t i = 1; i < lanes; ++i) lane[i] = local_[record[shader::fibletCodeByte(i + 1)]];
+  std::array<Frame4, shader::kFibletMaxPoints> lane, previous;
+  lane[0] = toFrame4(shader::fibletInitialTransform(p0, recordPoint(record, 1), v_));
+  for (uint32_t i = 1; i < lanes; ++i) lane[i] = local4_[record[shader::fibletCodeByte(i + 1)]];
   // Hillis-Steele: every lane reads the values of the previous step (the
   // GPU's barrier between steps), lane i >= offset combines with i - offset.
   for (uint32_t offset = 1; offset < lanes; offset *= 2) {
-    previous = lane;
-    for (uint32_t i = offset; i < lanes; ++i) lane[i] = shader::fibletCompose(previous[i - offset], previous[i]);
+    std::copy(lane.begin(), lane.begin() + lanes, previous.begin());
+    for (uint32_t i = offset; i < lanes; ++i) lane[i] = compose4(previous[i - offset], previous[i]);
   }
-  for (uint32_t i = 0; i < lanes; ++i) store(xyz, i + 1, lane[i].t);
+  for (uint32_t i = 0; i < lanes; ++i) store(xyz, i + 1, toVec3(lane[i].t));
   return count;
 }
 

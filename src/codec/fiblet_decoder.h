@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "codec/codec_params.h"
+#include "codec/fiblet_simd.h"
 #include "core/tractogram.h"
 #include "shared/fiblet.h"
 
@@ -94,6 +95,7 @@ class FibletDecoder {
   shader::vec3 v_;
   FibletDirectionTable table_;
   std::array<shader::FibletTransform, shader::kFibletCodeCount> local_;
+  std::array<Frame4, shader::kFibletCodeCount> local4_;
 };
 
 }  // namespace fibscope

@@ -5,11 +5,15 @@
 
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <random>
 
 #include "codec/codec_params.h"
 #include "codec/fiblet_decoder.h"
+#include "codec/fiblet_encoder.h"
+#include "codec/fiblet_simd.h"
+#include "phantom/phantom.h"
 #include "shared/fiblet.h"
 #include "test_support.h"
 
@@ -114,6 +118,87 @@ TEST(FibletDecode, recordsOfAnyCountOutsideTheRangeDecodeToNothing) {
     record[shader::fibletFlagsByte(8)] = uint8_t(count << 2);
     EXPECT_EQ(decoder.decodeSequential(record.data(), xyz), 0u) << count;
     EXPECT_EQ(decoder.decodeScan(record.data(), xyz), 0u) << count;
+  }
+}
+
+// The scalar decode exactly as the header documents it (shared functions on
+// vec3s), sequential and scan, as the references for the vectorised CPU
+// decoders: the GPU runs the scalar code, so the vector code must match it
+// bit for bit.
+void scalarDecode(const FibletDecoder& d, const uint8_t* record, bool scan, std::vector<float>& xyz) {
+  const uint32_t n = d.params().points_per_fiblet;
+  const uint32_t count = shader::fibletCount(record[shader::fibletFlagsByte(n)]);
+  const auto point = [&](int which) {
+    float c[3];
+    for (int axis = 0; axis < 3; ++axis)
+      c[axis] = shader::fibletDequantize(uint32_t(record[6 * which + 2 * axis]) | uint32_t(record[6 * which + 2 * axis + 1]) << 8);
+    return shader::vec3(c[0], c[1], c[2]);
+  };
+  const shader::vec3 v(d.params().v[0], d.params().v[1], d.params().v[2]);
+  xyz.clear();
+  const auto push = [&](shader::vec3 p) { xyz.insert(xyz.end(), {p.x, p.y, p.z}); };
+  push(point(0));
+  if (count == 1) return;
+  std::vector<shader::FibletTransform> lane(count - 1);
+  lane[0] = shader::fibletInitialTransform(point(0), point(1), v);
+  for (uint32_t i = 1; i + 1 < count; ++i) lane[i] = d.localTransform(record[shader::fibletCodeByte(i + 1)]);
+  if (scan) {
+    for (uint32_t offset = 1; offset < lane.size(); offset *= 2) {
+      const auto previous = lane;
+      for (uint32_t i = offset; i < lane.size(); ++i) lane[i] = shader::fibletCompose(previous[i - offset], previous[i]);
+    }
+  } else {
+    for (uint32_t i = 1; i < lane.size(); ++i) lane[i] = shader::fibletCompose(lane[i - 1], lane[i]);
+  }
+  for (const auto& w : lane) push(w.t);
+}
+
+TEST(FibletDecode, vectorisedDecodersAreBitIdenticalToTheSharedScalarArithmetic) {
+  PhantomOptions options;
+  options.streamlines = 60;
+  options.seed = 4;
+  options.threads = 1;
+  Tractogram t, chunk;
+  for (auto reader = openPhantom(options); reader->read(chunk);) t.append(chunk);
+  for (uint32_t n : {8u, 60u}) {
+    CodecParamOptions po;
+    po.points_per_fiblet = n;
+    const CodecParams params = chooseCodecParams(t, po);
+    const EncodedFiblets f = encodeTractogram(t, params);
+    const FibletDecoder decoder(params);
+    std::vector<float> want;
+    std::array<float, 3 * shader::kFibletMaxPoints> got;
+    for (size_t i = 0; i < f.fibletCount(); ++i) {
+      for (const bool scan : {false, true}) {
+        scalarDecode(decoder, f.record(i), scan, want);
+        const uint32_t count = scan ? decoder.decodeScan(f.record(i), got.data()) : decoder.decodeSequential(f.record(i), got.data());
+        ASSERT_EQ(size_t(count) * 3, want.size());
+        ASSERT_EQ(std::memcmp(got.data(), want.data(), want.size() * sizeof(float)), 0)
+            << "fiblet " << i << (scan ? " scan" : " sequential") << " N " << n;
+      }
+    }
+  }
+  // compose4 against fibletCompose on long chains of arbitrary transforms.
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<float> u(-1, 1);
+  const auto random = [&] {
+    shader::FibletTransform f;
+    f.c0 = shader::vec3(u(rng), u(rng), u(rng));
+    f.c1 = shader::vec3(u(rng), u(rng), u(rng));
+    f.c2 = shader::vec3(u(rng), u(rng), u(rng));
+    f.t = shader::vec3(u(rng), u(rng), u(rng));
+    return f;
+  };
+  for (int chain = 0; chain < 100; ++chain) {
+    shader::FibletTransform a = random();
+    Frame4 b = toFrame4(a);
+    for (int step = 0; step < 60; ++step) {
+      const shader::FibletTransform l = random();
+      a = shader::fibletCompose(a, l);
+      b = compose4(b, toFrame4(l));
+      const shader::FibletTransform c = toTransform(b);
+      ASSERT_EQ(std::memcmp(&a, &c, sizeof a), 0) << "chain " << chain << " step " << step;
+    }
   }
 }
 
