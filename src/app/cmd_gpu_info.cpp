@@ -63,6 +63,7 @@ void runGpuInfo(const GpuInfoOptions& options) {
       chosen = &gpu::chooseDevice(instance.devices(), options.device);
     } catch (const Error&) {
       for (const gpu::DeviceInfo& d : instance.devices()) printDevice(d, false);
+      std::fflush(stdout);  // the list before main()'s error line
       throw;
     }
     for (const gpu::DeviceInfo& d : instance.devices()) printDevice(d, &d == chosen);

@@ -191,7 +191,8 @@ std::string versionString(uint32_t version) {
 }
 
 VulkanInstance::VulkanInstance(const InstanceOptions& options)
-    : log_(options.log ? options.log : std::make_shared<DebugLog>(true)), validation_(options.validation) {
+    : log_(options.log ? options.log : std::make_shared<DebugLog>(options.validation)),
+      validation_(options.validation) {
   uint32_t loader_version = VK_API_VERSION_1_0;
   if (vkEnumerateInstanceVersion(&loader_version) != VK_SUCCESS || loader_version < VK_API_VERSION_1_3)
     throw Error("vulkan: the Vulkan loader is version " + versionString(loader_version) +

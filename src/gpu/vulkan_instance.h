@@ -48,7 +48,9 @@ struct InstanceOptions {
   // VK_LAYER_KHRONOS_validation with synchronisation validation; Error (one
   // line naming the Debian package) when the layer is not installed.
   bool validation = false;
-  // Where messages go; created (printing to stderr) when null.
+  // Where messages go; when null, a log that also prints them to stderr
+  // with validation on (without it, only the loader reports, and a failure
+  // it explains becomes the one-line Error).
   std::shared_ptr<DebugLog> log;
 };
 

@@ -184,17 +184,18 @@ TEST(GpuInfoCommand, missingVulkanDriverIsOneClearLine) {
   const test::CommandResult r = test::runCommand(
       "VK_DRIVER_FILES=/nonexistent/icd.json VK_ICD_FILENAMES=/nonexistent/icd.json " FIBSCOPE_EXE " gpu-info 2>&1");
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find("vulkan: no Vulkan driver found (install mesa-vulkan-drivers)"), std::string::npos)
-      << r.output;
+  EXPECT_EQ(r.output, "fibscope: error: vulkan: no Vulkan driver found (install mesa-vulkan-drivers)\n");
 }
 
 TEST(GpuInfoCommand, unknownDeviceNameIsOneClearLine) {
   const test::CommandResult r = test::runCommand(FIBSCOPE_EXE " gpu-info --device no-such-device-anywhere 2>&1");
   if (r.output.find("no Vulkan driver found") != std::string::npos) GTEST_SKIP() << "no Vulkan driver";
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find("fibscope: error: vulkan: no device name contains \"no-such-device-anywhere\""),
-            std::string::npos)
-      << r.output;
+  // The device list comes first, then the error as the last line.
+  const std::string error = "fibscope: error: vulkan: no device name contains \"no-such-device-anywhere\"";
+  const size_t at = r.output.find(error);
+  ASSERT_NE(at, std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find('\n', at), r.output.size() - 1) << r.output;
 }
 
 }  // namespace
