@@ -11,17 +11,6 @@ namespace fibscope {
 
 CodecErrorMeter::CodecErrorMeter() : histogram_(kBins, 0) {}
 
-void CodecErrorMeter::add(double distance_um) {
-  ++points_;
-  sum_ += distance_um;
-  sum2_ += distance_um * distance_um;
-  max_ = std::max(max_, distance_um);
-  // Multiply and truncate (distances are >= 0): std::floor and a division
-  // per point were a fifth of the compressor's time.
-  const double bin = distance_um * (1.0 / kBinUm);
-  histogram_[bin < double(kBins - 1) ? size_t(bin) : kBins - 1] += 1;
-}
-
 void CodecErrorMeter::merge(const CodecErrorMeter& other) {
   for (size_t i = 0; i < kBins; ++i) histogram_[i] += other.histogram_[i];
   points_ += other.points_;

@@ -26,7 +26,17 @@ struct CodecErrorStats {
 class CodecErrorMeter {
  public:
   CodecErrorMeter();
-  void add(double distance_um);
+  // Inline: the encoder measures every point it encodes.
+  void add(double distance_um) {
+    ++points_;
+    sum_ += distance_um;
+    sum2_ += distance_um * distance_um;
+    max_ = distance_um > max_ ? distance_um : max_;
+    // Multiply and truncate (distances are >= 0): std::floor and a division
+    // per point were a fifth of the compressor's time.
+    const double bin = distance_um * (1.0 / kBinUm);
+    histogram_[bin < double(kBins - 1) ? size_t(bin) : kBins - 1] += 1;
+  }
   // Adds the points of another meter (one meter per encoding thread).
   void merge(const CodecErrorMeter& other);
   CodecErrorStats stats() const;

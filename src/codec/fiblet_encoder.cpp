@@ -145,7 +145,7 @@ void FibletEncoder::startFiber(Lane& lane, const float* xyz, size_t n) {
   if (n > 0) startFiblet(lane);
 }
 
-void FibletEncoder::measure(const Lane& lane, V4f p, size_t index) {
+[[gnu::always_inline]] inline void FibletEncoder::measure(const Lane& lane, V4f p, size_t index) {
   const double* o = lane.target.data() + 3 * index;
   const double e2 = (double(p[0]) - o[0]) * (double(p[0]) - o[0]) + (double(p[1]) - o[1]) * (double(p[1]) - o[1]) +
                     (double(p[2]) - o[2]) * (double(p[2]) - o[2]);
