@@ -17,12 +17,10 @@ namespace {
 
 double degrees(double radians) { return radians * 180.0 / std::numbers::pi; }
 
-std::string modeName(const CompressReport& r, int radius) {
+std::string modeName(const CompressReport& r, int side) {
   switch (r.mode) {
-    case EncodeMode::ClosedLoop: {
-      const int side = 2 * radius + 1;
+    case EncodeMode::ClosedLoop:
       return "closed loop (" + std::to_string(side) + "x" + std::to_string(side) + " cell search)";
-    }
     case EncodeMode::OpenLoop:
       return "open loop (the paper's)";
     case EncodeMode::TrueFrame:
@@ -31,7 +29,7 @@ std::string modeName(const CompressReport& r, int radius) {
   return "?";
 }
 
-void printReport(const CompressReport& r, int radius, bool full) {
+void printReport(const CompressReport& r, int side, bool full) {
   const CodecParams& p = r.analysis.params;
   std::printf("wrote %s: %llu fibers, %llu points, %llu fiblets, %s (%.3f bytes/point); error max %.2f um, mean %.2f um\n",
               r.output.c_str(), static_cast<unsigned long long>(r.fibers), static_cast<unsigned long long>(r.points),
@@ -54,7 +52,7 @@ void printReport(const CompressReport& r, int radius, bool full) {
   else
     std::printf("  alpha       %.3f deg (given); largest turn %.2f deg\n", degrees(p.alpha), r.analysis.max_turn_deg);
   std::printf("  fiblets     N = %u points (%u-byte records), %s, %u threads\n", p.points_per_fiblet, p.recordBytes(),
-              modeName(r, radius).c_str(), r.threads);
+              modeName(r, side).c_str(), r.threads);
   std::printf("  error       max %.3f um, mean %.3f um, p99 %.2f um, rms %.3f um over %llu points (world space)\n",
               r.error.max_um, r.error.mean_um, r.error.p99_um, r.error.rms_um,
               static_cast<unsigned long long>(r.error.points));
@@ -76,7 +74,7 @@ void printReport(const CompressReport& r, int radius, bool full) {
               r.analyse_seconds, r.encode_seconds, formatCount(r.pointsPerSecond()).c_str());
 }
 
-nlohmann::json reportJson(const CompressReport& r, int radius) {
+nlohmann::json reportJson(const CompressReport& r, int side) {
   const CodecParams& p = r.analysis.params;
   const EncodeReport& e = r.encode;
   nlohmann::json j;
@@ -95,7 +93,7 @@ nlohmann::json reportJson(const CompressReport& r, int radius) {
                  {"turn_p99_9_deg", r.analysis.turn_percentile_deg},
                  {"max_turn_deg", r.analysis.max_turn_deg},
                  {"steps_off_fraction", r.analysis.steps_off_fraction}};
-  j["mode"] = modeName(r, radius);
+  j["mode"] = modeName(r, side);
   j["threads"] = r.threads;
   j["error_um"] = {{"max", r.error.max_um}, {"mean", r.error.mean_um}, {"p99", r.error.p99_um},
                    {"rms", r.error.rms_um}, {"points", r.error.points}};
@@ -151,9 +149,9 @@ void addCompressCommand(CLI::App& app) {
     const CompressReport r = compressTractogram([&input] { return openInput(input); }, opt->output, options);
     for (const auto& w : r.warnings) std::fprintf(stderr, "fibscope: warning: %s\n", w.c_str());
     if (opt->json)
-      std::printf("%s\n", reportJson(r, options.encode.search_radius).dump(2).c_str());
+      std::printf("%s\n", reportJson(r, options.encode.search_size).dump(2).c_str());
     else
-      printReport(r, options.encode.search_radius, opt->report);
+      printReport(r, options.encode.search_size, opt->report);
   });
 }
 

@@ -10,21 +10,31 @@ namespace fibscope {
 
 namespace {
 
-uint32_t gridCell(double c) {
-  // c in [-1, 1] -> 0..15; truncation equals floor where it matters
-  // (negative arguments clamp to 0 either way).
-  const double f = (c + 1.0) * 8.0;
-  return f >= double(shader::kFibletGridSize - 1) ? shader::kFibletGridSize - 1 : (f > 0 ? uint32_t(f) : 0u);
-}
+// Octahedral coordinates (ox, oy) of a hemisphere point -> continuous grid
+// coordinates: the 45-degree rotation onto the square [-1, 1]^2 (see
+// fibletOctahedralCell), scaled to [0, 16].
+DirectionGrid gridOf(double ox, double oy) { return {(ox + oy + 1.0) * 8.0, (ox - oy + 1.0) * 8.0}; }
 
-// Octahedral coordinates (ox, oy) of a hemisphere point -> its cell: the
-// 45-degree rotation onto the square [-1, 1]^2 (see fibletOctahedralCell),
-// then 16 x 16 cells.
-uint32_t octahedralCell(double ox, double oy) { return gridCell(ox + oy) << 4 | gridCell(ox - oy); }
+// floor(c) clamped to [0, limit] (NaN -> 0).
+uint32_t clampedFloor(double c, uint32_t limit) {
+  return c >= double(limit) ? limit : (c > 0 ? uint32_t(c) : 0u);
+}
 
 }  // namespace
 
-uint32_t encodeDirection(const double direction[3], double alpha) {
+uint32_t cellOf(DirectionGrid g) {
+  const uint32_t last = shader::kFibletGridSize - 1;
+  return clampedFloor(g.u, last) << 4 | clampedFloor(g.v, last);
+}
+
+uint32_t blockOrigin(DirectionGrid g, int size) {
+  // The size cells nearest to g along an axis start at floor(g - (size - 1) / 2).
+  const double shift = 0.5 * double(size - 1);
+  const uint32_t last = shader::kFibletGridSize - uint32_t(size);
+  return clampedFloor(g.u - shift, last) << 4 | clampedFloor(g.v - shift, last);
+}
+
+DirectionGrid encodeDirectionGrid(const double direction[3], double alpha) {
   const double norm =
       std::sqrt(direction[0] * direction[0] + direction[1] * direction[1] + direction[2] * direction[2]);
   double x = 0, y = 0, z = 1;
@@ -41,8 +51,10 @@ uint32_t encodeDirection(const double direction[3], double alpha) {
   const double hx = std::sin(theta_h) * std::cos(phi), hy = std::sin(theta_h) * std::sin(phi);
   // Onto the octahedron |x| + |y| + z = 1 (cos(theta_h) >= 0 up to rounding).
   const double s = std::fabs(hx) + std::fabs(hy) + std::max(std::cos(theta_h), 0.0);
-  return octahedralCell(hx / s, hy / s);
+  return gridOf(hx / s, hy / s);
 }
+
+uint32_t encodeDirection(const double direction[3], double alpha) { return cellOf(encodeDirectionGrid(direction, alpha)); }
 
 FastDirectionQuantizer::FastDirectionQuantizer(double alpha, double step)
     : sin2_alpha_(std::pow(std::sin(alpha), 2)),
@@ -66,12 +78,12 @@ FastDirectionQuantizer::FastDirectionQuantizer(double alpha, double step)
       const double r2 = d[0] * d[0] + d[1] * d[1];
       // Outside the unit disc: on the equator, i.e. beyond the cap (clamped to the rim).
       const double dir[3] = {d[0], d[1], r2 < 1 ? std::sqrt(1 - r2) : 0.0};
-      plane_[size_t(i * kPlaneBins + j)] = uint8_t(encodeDirection(dir, alpha));
+      plane_[size_t(i * kPlaneBins + j)] = uint8_t(blockOrigin(encodeDirectionGrid(dir, alpha), 2));
     }
   }
 }
 
-uint32_t FastDirectionQuantizer::cell(double x, double y, double z) const {
+uint32_t FastDirectionQuantizer::block2(double x, double y, double z) const {
   const double n2 = x * x + y * y + z * z;
   // Lengths within 20 % of the step: one Newton step from 1 / step gives
   // 1 / |d| to better than 2 % (relative error 3/8 e^2 for n2 = step^2 (1 + e)).
@@ -86,21 +98,21 @@ uint32_t FastDirectionQuantizer::cell(double x, double y, double z) const {
     const int j = fj <= 0 ? 0 : (fj >= kPlaneBins - 1 ? kPlaneBins - 1 : int(fj));
     return plane_[size_t(i * kPlaneBins + j)];
   }
-  return cellFromFormula(x, y, z);
+  return blockOrigin(gridFromFormula(x, y, z), 2);
 }
 
-uint32_t FastDirectionQuantizer::cellFromFormula(double x, double y, double z) const {
+DirectionGrid FastDirectionQuantizer::gridFromFormula(double x, double y, double z) const {
   const double r2 = x * x + y * y;
   const double n2 = r2 + z * z;
   // Zero or non-finite input: straight ahead, as encodeDirection.
-  if (!(n2 > 0) || !std::isfinite(n2)) return octahedralCell(0, 0);
+  if (!(n2 > 0) || !std::isfinite(n2)) return gridOf(0, 0);
   const double u = r2 / n2;
   // Beyond the cap (or behind, z <= 0) the direction is clamped to the rim:
   // the mapped angle is pi/2, on the equator of the hemisphere.
   if (z <= 0 || (!cap_is_hemisphere_ && u >= sin2_alpha_)) {
     const double s = std::fabs(x) + std::fabs(y);
-    if (s == 0) return octahedralCell(1, 0);  // straight back: encodeDirection's atan2(0, 0) = 0
-    return octahedralCell(x / s, y / s);
+    if (s == 0) return gridOf(1, 0);  // straight back: encodeDirection's atan2(0, 0) = 0
+    return gridOf(x / s, y / s);
   }
   const double f = u * index_scale_;
   const auto i = std::min(size_t(f), size_t(kEntries));
@@ -108,7 +120,7 @@ uint32_t FastDirectionQuantizer::cellFromFormula(double x, double y, double z) c
   const double ratio = ratio_[i] + w * (ratio_[i + 1] - ratio_[i]);
   const double cos_h = cos_mapped_[i] + w * (cos_mapped_[i + 1] - cos_mapped_[i]);
   const double scale = ratio / (ratio * (std::fabs(x) + std::fabs(y)) + cos_h * std::sqrt(n2));
-  return octahedralCell(x * scale, y * scale);
+  return gridOf(x * scale, y * scale);
 }
 
 }  // namespace fibscope

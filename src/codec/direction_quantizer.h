@@ -11,31 +11,44 @@
 
 namespace fibscope {
 
-// The exact nearest cell, in double with trigonometry: the reference, and
-// the open-loop encoder's quantiser (the paper's). `direction` need not be
+// A direction's position on the 16 x 16 grid as continuous coordinates
+// (u, v) in [0, 16]: cell (floor(u), floor(v)) is its code.
+struct DirectionGrid {
+  double u = 0, v = 0;
+};
+
+// The exact position, in double with trigonometry: the reference, and the
+// open-loop encoder's quantiser (the paper's). `direction` need not be
 // unit; a zero or non-finite one encodes as straight ahead.
+DirectionGrid encodeDirectionGrid(const double direction[3], double alpha);
+// The code of the cell holding g.
+uint32_t cellOf(DirectionGrid g);
+// The code of the first cell (lowest u and v) of the size x size block of
+// cells nearest g, kept inside the grid; the block always holds cellOf(g).
+uint32_t blockOrigin(DirectionGrid g, int size);
+// cellOf(encodeDirectionGrid(direction, alpha)).
 uint32_t encodeDirection(const double direction[3], double alpha);
 
-// An approximation of the same mapping for the closed-loop encoder's inner
-// loop, where the direction is the vector from the decoded point to the
-// original point and so has a length close to the step. Such vectors go
-// through a 256 x 256 table over the tangent plane of the cap, (x, y) / |d|
-// in [-sin(alpha), sin(alpha)]^2, whose entries are encodeDirection of the
-// bin centres; 1 / |d| is one Newton step of rsqrt from 1 / step (no sqrt or
-// division per point). Other vectors (length off by more than 20 %, or
-// pointing backwards) take the exact formula without trigonometry:
-// with u = sin^2(theta) and k = (pi/2) / alpha the octahedral coordinates
-// are (x, y) * R / (R * (|x| + |y|) + C * |d|), R = sin(k theta) /
-// sin(theta), C = cos(k theta), both even in theta and so smooth in u, read
-// from tables over u. The result is the exact cell or, within about 1/16 of
-// a cell of a border (a few percent of directions), its neighbour (tested):
-// harmless here, since the closed loop searches the neighbours anyway.
+// A fast blockOrigin(encodeDirectionGrid(d), 2) for the closed-loop
+// encoder's inner loop, where d is the vector from the decoded point to
+// the original point and so has a length close to the step. Such vectors
+// go through a 256 x 256 table over the tangent plane of the cap, (x, y) /
+// |d| in [-sin(alpha), sin(alpha)]^2, whose entries are the block of each
+// bin's centre; 1 / |d| is one Newton step of rsqrt from 1 / step (no sqrt
+// or division per point). Other vectors (length off by more than 20 %, or
+// pointing backwards) take gridFromFormula: with u = sin^2(theta) and
+// k = (pi/2) / alpha the octahedral coordinates are
+// (x, y) * R / (R * (|x| + |y|) + C * |d|), R = sin(k theta) / sin(theta),
+// C = cos(k theta), both even in theta and so smooth in u, read from
+// tables over u. Near a half-cell border the block may be the neighbouring
+// one (tested); it still holds the exact cell, and the closed loop only
+// needs the nearest cells among its candidates.
 class FastDirectionQuantizer {
  public:
   FastDirectionQuantizer(double alpha, double step);
-  uint32_t cell(double x, double y, double z) const;
-  // The path without the tangent-plane table (any length).
-  uint32_t cellFromFormula(double x, double y, double z) const;
+  uint32_t block2(double x, double y, double z) const;
+  // The position without the tangent-plane table (any length).
+  DirectionGrid gridFromFormula(double x, double y, double z) const;
 
  private:
   static constexpr int kEntries = 2048;

@@ -32,53 +32,39 @@ double EncodeReport::maxTurnDegrees() const {
   return std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / std::numbers::pi;
 }
 
-float FibletEncoder::searchAround(uint32_t centre, float lx, float ly, float lz, uint32_t& code) const {
-  const int ci = int(centre >> 4), cj = int(centre & 15u), radius = options_.search_radius;
-  // Squared distance of candidate c's step to the local goal, in float; the
-  // vector path below does the same operations lane by lane, so both paths
-  // pick the same code (the first smallest in row-major order).
-  const auto distance2 = [&](uint32_t c) {
-    const float ex = step_x_[c] - lx, ey = step_y_[c] - ly, ez = step_z_[c] - lz;
-    return ex * ex + ey * ey + ez * ez;
-  };
-  if (radius == 1 && ci >= 1 && ci <= 14 && cj >= 1 && cj <= 14) {
-    // The 3 x 3 block as three rows of four lanes (the fourth ignored).
-    float e2[12];
-    for (int row = 0; row < 3; ++row) {
-      const size_t at = size_t(((ci - 1 + row) << 4) + cj - 1);
-      V4f x, y, z;
-      std::memcpy(&x, &step_x_[at], sizeof x);
-      std::memcpy(&y, &step_y_[at], sizeof y);
-      std::memcpy(&z, &step_z_[at], sizeof z);
-      const V4f ex = x - splat4(lx), ey = y - splat4(ly), ez = z - splat4(lz);
-      const V4f d2 = ex * ex + ey * ey + ez * ez;
-      std::memcpy(&e2[4 * row], &d2, sizeof d2);
-    }
+float FibletEncoder::search(const double local[3], uint32_t& code) const {
+  const auto lx = float(local[0]), ly = float(local[1]), lz = float(local[2]);
+  if (options_.search_size == 2) {
+    // The default: the 2 x 2 cells nearest the goal's direction, one
+    // four-lane vector (candidates in row-major order).
+    const uint32_t origin = quantizer_.block2(local[0], local[1], local[2]);
+    const Block& b = blocks_[origin];
+    const V4f ex = b.x - splat4(lx), ey = b.y - splat4(ly), ez = b.z - splat4(lz);
+    const V4f d2 = ex * ex + ey * ey + ez * ez;
     // The first smallest without branches (its position is data, so
     // branches mispredict): distances are >= 0, so their bits order as
-    // integers, and (bits << 4 | position) orders by distance, then by
-    // row-major position; a tree of integer minimums (cmov) picks it.
-    const auto key = [&](int c) {
-      uint32_t bits;
-      std::memcpy(&bits, &e2[c], sizeof bits);
-      return uint64_t(bits) << 4 | uint64_t(c);
-    };
-    const auto least = [](uint64_t a, uint64_t b) { return b < a ? b : a; };
-    const uint64_t top = least(least(least(key(0), key(1)), least(key(2), key(4))),
-                               least(least(key(5), key(6)), least(key(8), key(9))));
-    const uint64_t pick = least(top, key(10));
-    const int index = int(pick & 15u);
-    code = uint32_t(((ci - 1 + index / 4) << 4) + cj - 1 + index % 4);
-    return e2[index];
+    // integers, and (bits << 2 | position) orders by distance, then by
+    // position; integer minimums compile to cmov.
+    uint32_t bits[4];
+    std::memcpy(bits, &d2, sizeof bits);
+    const auto key = [&](int c) { return uint64_t(bits[c]) << 2 | uint64_t(c); };
+    const auto least = [](uint64_t x, uint64_t y) { return y < x ? y : x; };
+    const int pick = int(least(least(key(0), key(1)), least(key(2), key(3))) & 3u);
+    code = origin + uint32_t(pick >> 1) * 16u + uint32_t(pick & 1);
+    return d2[pick];
   }
+  // Any other block size, one candidate after the other (same distances).
+  const int size = options_.search_size;
+  const uint32_t origin = blockOrigin(quantizer_.gridFromFormula(local[0], local[1], local[2]), size);
   float best = std::numeric_limits<float>::infinity();
-  for (int i = std::max(ci - radius, 0); i <= std::min(ci + radius, 15); ++i) {
-    for (int j = std::max(cj - radius, 0); j <= std::min(cj + radius, 15); ++j) {
-      const auto candidate = uint32_t(i << 4 | j);
-      const float e2 = distance2(candidate);
+  for (int i = 0; i < size; ++i) {
+    for (int j = 0; j < size; ++j) {
+      const uint32_t c = origin + uint32_t(16 * i + j);
+      const float ex = step_x_[c] - lx, ey = step_y_[c] - ly, ez = step_z_[c] - lz;
+      const float e2 = ex * ex + ey * ey + ez * ez;
       if (e2 < best) {
         best = e2;
-        code = candidate;
+        code = c;
       }
     }
   }
@@ -106,7 +92,7 @@ FibletEncoder::FibletEncoder(const CodecParams& params, const EncodeOptions& opt
   cos_alpha_ = std::cos(double(params.alpha)) - 1e-6;
   cos2_alpha_ = cos_alpha_ * cos_alpha_;
   max_error2_ = std::pow(options.max_point_error * delta, 2);
-  if (options.search_radius < 0 || options.search_radius > 15) fail("fiblet encoder", "search radius outside [0, 15]");
+  if (options.search_size < 1 || options.search_size > 16) fail("fiblet encoder", "search size outside [1, 16]");
   step_x_.fill(0);
   step_y_.fill(0);
   step_z_.fill(0);
@@ -116,6 +102,14 @@ FibletEncoder::FibletEncoder(const CodecParams& params, const EncodeOptions& opt
     step_y_[c] = step.y;
     step_z_[c] = step.z;
     local4_[c] = toFrame4(decoder_.localTransform(c));
+  }
+  for (uint32_t o = 0; o < shader::kFibletCodeCount; ++o) {
+    // Blocks start at i, j <= 14; other origins are never used (kept zero).
+    if ((o >> 4) > 14 || (o & 15u) > 14) continue;
+    const uint32_t c[4] = {o, o + 1, o + 16, o + 17};
+    blocks_[o] = {V4f{step_x_[c[0]], step_x_[c[1]], step_x_[c[2]], step_x_[c[3]]},
+                  V4f{step_y_[c[0]], step_y_[c[1]], step_y_[c[2]], step_y_[c[3]]},
+                  V4f{step_z_[c[0]], step_z_[c[1]], step_z_[c[2]], step_z_[c[3]]}};
   }
 }
 
@@ -227,8 +221,7 @@ bool FibletEncoder::stepFiblet(Lane& lane) {
     // |L_c.t - local|: the search runs in local coordinates.
     const double diff[3] = {here[0] - w.t[0], here[1] - w.t[1], here[2] - w.t[2]};
     const double local[3] = {dot3(w.c0, diff), dot3(w.c1, diff), dot3(w.c2, diff)};
-    const uint32_t centre = quantizer_.cell(local[0], local[1], local[2]);
-    const float best = searchAround(centre, float(local[0]), float(local[1]), float(local[2]), code);
+    const float best = search(local, code);
     if (double(best) > max_error2_) {
       ++report_.error_splits;
       return false;

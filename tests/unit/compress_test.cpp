@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <map>
 #include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -301,9 +302,13 @@ TEST(Compressor, failureDuringEncodingLeavesNothingBehind) {
   EXPECT_TRUE(std::filesystem::is_empty(dir.path())) << "left files in " << dir.path();
 }
 
-TEST(FastDirectionQuantizer, agreesWithTheExactQuantiserOrPicksANeighbourAtBorders) {
+TEST(FastDirectionQuantizer, blockHoldsTheExactCellAndMatchesTheExactBlockAwayFromBorders) {
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> unit(-1, 1);
+  const auto holds = [](uint32_t origin, uint32_t cell) {
+    const int di = int(cell >> 4) - int(origin >> 4), dj = int(cell & 15) - int(origin & 15);
+    return di >= 0 && di <= 1 && dj >= 0 && dj <= 1;
+  };
   for (double alpha_deg : {3.0, 8.0, 15.0, 30.0, 60.0, 90.0}) {
     const double alpha = alpha_deg * kDeg, step = 0.0007;
     const FastDirectionQuantizer fast(alpha, step);
@@ -314,25 +319,51 @@ TEST(FastDirectionQuantizer, agreesWithTheExactQuantiserOrPicksANeighbourAtBorde
       d[2] = std::sqrt(std::max(1 - d[0] * d[0] - d[1] * d[1], 0.0));
       const double length = step * (1 + 0.1 * unit(rng));
       for (double& c : d) c *= length;
-      const uint32_t exact = encodeDirection(d, alpha);
-      const uint32_t got = fast.cell(d[0], d[1], d[2]);
-      const uint32_t formula = fast.cellFromFormula(d[0], d[1], d[2]);
+      const DirectionGrid exact = encodeDirectionGrid(d, alpha);
+      const uint32_t got = fast.block2(d[0], d[1], d[2]);
       ++total;
-      same += got == exact;
-      EXPECT_LE(std::abs(int(got >> 4) - int(exact >> 4)), 1) << alpha_deg;
-      EXPECT_LE(std::abs(int(got & 15) - int(exact & 15)), 1) << alpha_deg;
-      EXPECT_LE(std::abs(int(formula >> 4) - int(exact >> 4)), 1) << alpha_deg;
-      EXPECT_LE(std::abs(int(formula & 15) - int(exact & 15)), 1) << alpha_deg;
+      same += got == blockOrigin(exact, 2);
+      ASSERT_TRUE(holds(got, cellOf(exact))) << "alpha " << alpha_deg << " block " << got << " cell " << cellOf(exact);
+      const DirectionGrid formula = fast.gridFromFormula(d[0], d[1], d[2]);
+      EXPECT_NEAR(formula.u, exact.u, 0.05) << alpha_deg;  // linear interpolation near the rim at 90 deg
+      EXPECT_NEAR(formula.v, exact.v, 0.05) << alpha_deg;
     }
-    // Bins straddling a border (2 of 16 per axis) and 1/|d| from one
-    // Newton step leave a few percent on the neighbouring cell.
+    // Table bins straddling a half-cell border (1/16 of a cell wide) and
+    // 1/|d| from one Newton step leave a few percent on the next block.
     EXPECT_GE(same, total * 90 / 100) << "alpha " << alpha_deg;
   }
   // Far from the step, backwards and degenerate vectors take the formula.
   const FastDirectionQuantizer fast(10 * kDeg, 1.0);
   for (const auto& d : std::vector<std::array<double, 3>>{{0.1, 0.2, 5}, {0.3, -0.1, -1}, {0, 0, -1}, {0, 0, 0}}) {
-    EXPECT_EQ(fast.cell(d[0], d[1], d[2]), encodeDirection(d.data(), 10 * kDeg));
+    EXPECT_EQ(fast.block2(d[0], d[1], d[2]), blockOrigin(encodeDirectionGrid(d.data(), 10 * kDeg), 2));
   }
+  // Blocks stay inside the grid and hold the cell at every corner.
+  for (const DirectionGrid g : {DirectionGrid{0, 0}, DirectionGrid{16, 16}, DirectionGrid{0.2, 15.9}, DirectionGrid{7.5, 8.49}}) {
+    for (int size : {1, 2, 3, 5}) {
+      const uint32_t o = blockOrigin(g, size);
+      EXPECT_LE(int(o >> 4) + size, 16);
+      EXPECT_LE(int(o & 15) + size, 16);
+      const uint32_t c = cellOf(g);
+      EXPECT_TRUE(int(c >> 4) >= int(o >> 4) && int(c >> 4) < int(o >> 4) + size) << size;
+      EXPECT_TRUE(int(c & 15) >= int(o & 15) && int(c & 15) < int(o & 15) + size) << size;
+    }
+  }
+}
+
+TEST(Compressor, blockSizesTwoAndThreeGiveTheSameErrorsAndOneIsWorse) {
+  TempDir dir;
+  std::map<int, CompressReport> by_size;
+  for (int size : {1, 2, 3}) {
+    CompressOptions options = quietOptions();
+    options.encode.search_size = size;
+    by_size[size] = compressTractogram([] { return phantomReader(100); }, dir.file(std::to_string(size) + ".fbl"), options);
+  }
+  std::cout << "[search] max error 1x1 " << by_size[1].error.max_um << " um, 2x2 " << by_size[2].error.max_um
+            << " um, 3x3 " << by_size[3].error.max_um << " um; mean " << by_size[1].error.mean_um << " / "
+            << by_size[2].error.mean_um << " / " << by_size[3].error.mean_um << "\n";
+  EXPECT_NEAR(by_size[2].error.max_um, by_size[3].error.max_um, 0.02 * by_size[3].error.max_um);
+  EXPECT_NEAR(by_size[2].error.mean_um, by_size[3].error.mean_um, 0.01 * by_size[3].error.mean_um);
+  EXPECT_GT(by_size[1].error.mean_um, by_size[2].error.mean_um);
 }
 
 TEST(ThreadPool, runsEveryJobOnItsWorkersAndPassesExceptionsToTheCaller) {
