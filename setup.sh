@@ -58,7 +58,9 @@ status=0
 (cd build && ctest --output-on-failure -j "$jobs" --timeout 600) || status=1
 configure build-asan -DCMAKE_BUILD_TYPE=Debug -DFIBSCOPE_SANITIZE=ON -DFIBSCOPE_BENCH=OFF
 ninja -C build-asan -j "$jobs" --quiet
+lsan_suppressions=$PWD/tests/lsan_suppressions.txt  # third-party Vulkan libraries only
 (cd build-asan && ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+   LSAN_OPTIONS=suppressions="$lsan_suppressions":print_suppressions=0 \
    ctest --output-on-failure -j "$jobs" --timeout 900) || status=1
 # Every reader's fuzzer for a fixed number of runs (deterministic seed).
 scripts/fuzz.sh --runs 20000 || status=1

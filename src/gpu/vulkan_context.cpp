@@ -67,12 +67,13 @@ VulkanContext::VulkanContext(const ContextOptions& options)
 
   // Only what the passes use: buffer device addresses for every buffer (no
   // descriptor sets for data), 64-bit integers and atomics for the
-  // visibility buffer, synchronization2 barriers.
+  // visibility buffer, synchronization2 barriers, dynamic rendering.
   VkPhysicalDeviceVulkan13Features features13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
   features13.synchronization2 = VK_TRUE;
   // glslc's Vulkan 1.3 SPIR-V declares workgroup sizes with LocalSizeId,
   // which needs maintenance4 (a feature every 1.3 device has).
   features13.maintenance4 = VK_TRUE;
+  features13.dynamicRendering = VK_TRUE;  // graphics passes without render pass objects
   VkPhysicalDeviceVulkan12Features features12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
   features12.pNext = &features13;
   features12.bufferDeviceAddress = VK_TRUE;

@@ -101,6 +101,7 @@ DeviceInfo describeDevice(VkPhysicalDevice device, uint32_t index) {
   info.buffer_int64_atomics = features12.shaderBufferInt64Atomics;
   info.synchronization2 = features13.synchronization2;
   const bool maintenance4 = features13.maintenance4;
+  const bool dynamic_rendering = features13.dynamicRendering;
 
   uint32_t count = 0;
   vkEnumerateDeviceExtensionProperties(device, nullptr, &count, nullptr);
@@ -133,6 +134,7 @@ DeviceInfo describeDevice(VkPhysicalDevice device, uint32_t index) {
   if (!info.buffer_int64_atomics) appendMissing(info.missing, "no shaderBufferInt64Atomics");
   if (!info.synchronization2) appendMissing(info.missing, "no synchronization2");
   if (api >= VK_API_VERSION_1_3 && !maintenance4) appendMissing(info.missing, "no maintenance4");
+  if (api >= VK_API_VERSION_1_3 && !dynamic_rendering) appendMissing(info.missing, "no dynamicRendering");
   return info;
 }
 

@@ -128,6 +128,52 @@ TEST_F(GpuContext, clearedImageDownloadsAsRgba8) {
   }
 }
 
+TEST_F(GpuContext, graphicsPipelineDrawsATriangleWithDynamicRendering) {
+  // Clip space (-1,-1) is the top-left corner in Vulkan: the triangle covers
+  // the pixels above the anti-diagonal, i.e. centres with x + y < size.
+  constexpr uint32_t kSize = 64;
+  const float positions[] = {-1, -1, 1, -1, -1, 1};
+  gpu::Buffer& vertices = buffer(sizeof positions, gpu::MemoryUse::Upload);
+  gpu::uploadToBuffer(context(), vertices, positions, sizeof positions);
+  struct Push {
+    uint64_t positions;
+    float r, g, b, a;
+  } push{vertices.address, 0.0f, 1.0f, 0.0f, 1.0f};
+  gpu::GraphicsPipelineDesc desc;
+  desc.vertex_shader = "triangle_test.vert";
+  desc.fragment_shader = "triangle_test.frag";
+  desc.push_constant_bytes = sizeof push;
+  gpu::GraphicsPipeline& triangle = graphicsPipeline(desc);
+  gpu::Image& target = image(kSize, kSize, VK_FORMAT_R8G8B8A8_UNORM,
+                             VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
+  ASSERT_NE(target.view, VK_NULL_HANDLE);
+  gpu::submitOnce(context(), [&](VkCommandBuffer cmd) {
+    gpu::beginRendering(cmd, target, VkClearColorValue{{0.0f, 0.0f, 1.0f, 1.0f}});
+    gpu::recordDraw(cmd, triangle, push, 3);
+    gpu::endRendering(cmd);
+  });
+  const std::vector<uint8_t> pixels = gpu::downloadImageRgba8(context(), target);
+  uint32_t green = 0, blue = 0;
+  for (uint32_t y = 0; y < kSize; ++y)
+    for (uint32_t x = 0; x < kSize; ++x) {
+      const uint8_t* p = &pixels[4 * (y * kSize + x)];
+      const bool is_green = p[0] == 0 && p[1] == 255 && p[2] == 0 && p[3] == 255;
+      const bool is_blue = p[0] == 0 && p[1] == 0 && p[2] == 255 && p[3] == 255;
+      ASSERT_TRUE(is_green || is_blue) << "pixel " << x << ", " << y;
+      // Centres exactly on the diagonal (x + y + 1 == size) go by the
+      // fill rule; everything else is decided.
+      if (x + y + 1 < kSize) {
+        EXPECT_TRUE(is_green) << "pixel " << x << ", " << y;
+      } else if (x + y + 1 > kSize) {
+        EXPECT_TRUE(is_blue) << "pixel " << x << ", " << y;
+      }
+      green += is_green;
+      blue += is_blue;
+    }
+  EXPECT_GE(green, kSize * (kSize - 1) / 2);
+  EXPECT_GE(blue, kSize * (kSize - 1) / 2);
+}
+
 TEST_F(GpuContext, timestampQueriesMeasureAPositiveTimePerPass) {
   constexpr uint32_t kCount = 1 << 20;
   gpu::Buffer& src = buffer(kCount * 4, gpu::MemoryUse::DeviceLocal);
