@@ -225,6 +225,25 @@ TEST_F(GpuContext, validationLayerReportsADeliberateMisuse) {
   log().clear();  // provoked on purpose: not a failure of this test
 }
 
+TEST_F(GpuContext, synchronisationValidationReportsAMissingBarrier) {
+  // A fill and a copy out of the filled buffer with no barrier between them:
+  // a read-after-write hazard that only synchronisation validation sees.
+  // (It tracks transfers and descriptor-bound resources; shader accesses
+  // through buffer device addresses are invisible to it, so barriers
+  // between compute passes can only be tested through their results.)
+  gpu::Buffer& src = buffer(1024, gpu::MemoryUse::DeviceLocal);
+  gpu::Buffer& dst = buffer(1024, gpu::MemoryUse::DeviceLocal);
+  gpu::submitOnce(context(), [&](VkCommandBuffer cmd) {
+    vkCmdFillBuffer(cmd, src.buffer, 0, VK_WHOLE_SIZE, 1);
+    const VkBufferCopy region{0, 0, 1024};
+    vkCmdCopyBuffer(cmd, src.buffer, dst.buffer, 1, &region);
+  });
+  bool hazard = false;
+  for (const std::string& m : log().messages()) hazard |= m.find("SYNC-HAZARD-READ") != std::string::npos;
+  EXPECT_TRUE(hazard) << "synchronisation validation is not active";
+  log().clear();  // provoked on purpose
+}
+
 TEST(GpuInfoCommand, missingVulkanDriverIsOneClearLine) {
   // Point the loader at a driver list that does not exist.
   const test::CommandResult r = test::runCommand(
