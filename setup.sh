@@ -50,6 +50,8 @@ if [ "$mode" = run ]; then
   mkdir -p out
   [ -f out/phantom.tck ] || ./build/fibscope phantom out/phantom.tck --streamlines 20000 --seed 1
   ./build/fibscope info out/phantom.tck
+  # The fiblet compression of it, with the report (size, error, speed).
+  ./build/fibscope compress out/phantom.tck out/phantom.fbl --report --force
   exit 0
 fi
 
