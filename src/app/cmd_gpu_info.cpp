@@ -80,7 +80,8 @@ void addGpuInfoCommand(CLI::App& app) {
   auto options = std::make_shared<GpuInfoOptions>();
   CLI::App* cmd = app.add_subcommand("gpu-info", "List Vulkan devices and the one fibscope renders with");
   cmd->add_flag("--validate", options->validate, "Enable the Vulkan validation layers");
-  cmd->add_option("--device", options->device, "Use the first device whose name contains NAME (case-insensitive)");
+  cmd->add_option("--device", options->device, "Use the first device whose name contains NAME (case-insensitive)")
+      ->option_text("NAME");
   cmd->callback([options] { runGpuInfo(*options); });
 }
 
