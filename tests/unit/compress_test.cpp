@@ -148,6 +148,29 @@ TEST(CompressCli, reportNamesEveryFigureTheIssueAsksFor) {
   EXPECT_NE(again.output.find("exists"), std::string::npos) << again.output;
 }
 
+TEST(CompressCli, givenFibletSizeStepAndAngleAreUsedAndReported) {
+  TempDir dir;
+  const std::string tck = writePhantom(dir, 0.1, 40);
+  const nlohmann::json r = compressJson(tck, dir.file("p.fbl"), "--points 32 --step 0.1 --max-angle 12 --threads 1");
+  ASSERT_TRUE(r.contains("params"));
+  EXPECT_EQ(r["params"]["points_per_fiblet"], 32);
+  EXPECT_FALSE(r["params"]["step_measured"]);
+  EXPECT_FALSE(r["params"]["alpha_measured"]);
+  EXPECT_NEAR(double(r["params"]["alpha_deg"]), 12.0, 1e-4);
+  EXPECT_NEAR(double(r["params"]["step_mm"]), 0.1, 1e-6);
+  EXPECT_EQ(r["threads"], 1);
+  EXPECT_LE(double(r["error_um"]["max"]), 10.0);
+  const FblFile f = FblFile::open(dir.file("p.fbl"));
+  EXPECT_EQ(f.header().points_per_fiblet, 32u);
+  EXPECT_EQ(f.header().fiblet_record_bytes, 44u);  // 32 + 11 rounded up to 4
+  // N must be a multiple of 4 in [8, 60].
+  for (const char* bad : {"--points 30", "--points 4", "--points 64"}) {
+    const auto e = runFibscope("compress " + tck + " " + dir.file("bad.fbl") + " " + bad);
+    EXPECT_EQ(e.exit_code, 2) << bad << ": " << e.output;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("bad.fbl"))) << bad;
+  }
+}
+
 TEST(CompressCli, outlierCoordinateIsRejectedInOneLineAndNothingIsWritten) {
   TempDir dir;
   Tractogram t = test::smallTractogram(20, 3);
