@@ -287,9 +287,9 @@ void FibletEncoder::encodeStreamline(const float* xyz, size_t n, EncodedFiblets&
 
 void FibletEncoder::encode(const Tractogram& chunk, EncodedFiblets& out) {
   checkOutput(out);
-  // Two fibers at a time, a point of each in turn: each point depends on
+  // kLanes fibers at a time, a point of each in turn: each point depends on
   // the previous one through the decoded frame (a chain of ~100 cycles of
-  // latency), and the two chains overlap in the out-of-order core. Fibers
+  // latency), and the lanes' chains overlap in the out-of-order core. Fibers
   // are placed in the lanes' buffers as they finish and copied out in input
   // order, so the output is the same as one fiber after the other.
   const size_t fibers = chunk.streamlineCount();
@@ -312,13 +312,17 @@ void FibletEncoder::encode(const Tractogram& chunk, EncodedFiblets& out) {
     placements_[lane.fiber] = {uint8_t(l), lane.fiber_offset, lane.fiber_fiblets};
     startNext(l);
   };
-  startNext(0);
-  startNext(1);
-  while (lanes_[0].active && lanes_[1].active) {
-    advance(0);
-    advance(1);
+  for (size_t l = 0; l < kLanes; ++l) startNext(l);
+  // While every lane has work, a point of each in turn; then the stragglers.
+  bool all_active = true;
+  for (const Lane& lane : lanes_) all_active = all_active && lane.active;
+  while (all_active) {
+    for (size_t l = 0; l < kLanes; ++l) {
+      advance(l);
+      all_active = all_active && lanes_[l].active;
+    }
   }
-  for (size_t l = 0; l < 2; ++l)
+  for (size_t l = 0; l < kLanes; ++l)
     while (lanes_[l].active) advance(l);
   for (size_t s = 0; s < fibers; ++s) {
     const Placement& p = placements_[s];
