@@ -9,6 +9,7 @@
 
 #include "codec/fbl_codec.h"
 #include "codec/fbl_file.h"
+#include "codec/fbl_reader.h"
 #include "core/error.h"
 #include "core/output_file.h"
 #include "core/spill_file.h"
@@ -26,6 +27,7 @@ double secondsSince(Clock::time_point start) {
 
 // One chunk of fibers on its way through a worker.
 struct ChunkJob {
+  std::string source;  // the input path, for messages
   Tractogram input;
   EncodedFiblets fiblets;     // fiblet indices local to the chunk (fiblet_base 0)
   std::vector<float> lengths; // arc length of each input fiber, mm
@@ -48,14 +50,23 @@ float polylineLength(const float* p, size_t n) {
 
 void encodeChunk(FibletEncoder& encoder, ChunkJob& job, bool resample, double delta_mm) {
   const Tractogram& in = job.input;
+  // What openFbl accepts: one fiber is decoded whole into memory.
+  const auto checkLengths = [&](const Tractogram& t) {
+    for (size_t s = 0; s < t.streamlineCount(); ++s)
+      if (t.pointsIn(s) > kFblMaxFiberPoints)
+        fail(job.source, "a streamline has " + std::to_string(t.pointsIn(s)) + " points, more than the " +
+                             std::to_string(kFblMaxFiberPoints) + " a .fbl fiber may hold");
+  };
   job.lengths.resize(in.streamlineCount());
   for (size_t s = 0; s < in.streamlineCount(); ++s) job.lengths[s] = polylineLength(in.point(in.offsets[s]), in.pointsIn(s));
   job.fiblets.record_bytes = encoder.decoder().params().recordBytes();
   if (resample) {
     const Tractogram resampled = resampleToStep(in, delta_mm, &job.resample);
+    checkLengths(resampled);
     encoder.encode(resampled, job.fiblets);
     job.encoded_points = resampled.pointCount();
   } else {
+    checkLengths(in);
     encoder.encode(in, job.fiblets);
     job.encoded_points = in.pointCount();
   }
@@ -219,6 +230,7 @@ CompressReport compressTractogram(const ReaderFactory& open_input, const std::st
       std::shared_ptr<ChunkJob> job;
       if (spare.empty()) {
         job = std::make_shared<ChunkJob>();
+        job->source = header.path;
         // A chunk ends with a whole streamline, a little past chunk_points.
         job->input.positions.reserve(3 * (options.chunk_points + options.chunk_points / 4));
       } else {
