@@ -1,0 +1,53 @@
+// The camera block shared by the C++ renderer and the shaders (a uniform or
+// storage block; std140 and std430 lay it out identically because every
+// member is a vec4 or an array of vec4).
+//
+// Conventions (Vulkan; src/render/camera.h builds the matrices, the CPU
+// reference rasteriser src/render/reference_raster.h follows them exactly):
+//   - world space is RAS+ millimetres (DESIGN.md section 4);
+//   - the view is right-handed and looks down its -z axis: x_view to the
+//     right of the image, y_view up in the image;
+//   - clip depth lies in [0, 1]: the near plane maps to 0, the far plane to
+//     1 (z_ndc = z_clip / w_clip; w_clip = -z_view > 0 in front of the eye);
+//   - the framebuffer's y axis points DOWN: y_ndc = -1 is the top row
+//     (the projection negates y_view, no negative viewport height needed);
+//   - window coordinates: x_w = (x_ndc + 1) * width / 2,
+//                         y_w = (y_ndc + 1) * height / 2;
+//     pixel (px, py) covers [px, px + 1) x [py, py + 1), centre
+//     (px + 0.5, py + 0.5);
+//   - matrices are column-major, stored as four vec4 COLUMNS (glsl_cpp.h has
+//     no mat4 for C++): m[c] is column c, so clip = m[0] * x + m[1] * y +
+//     m[2] * z + m[3] * 1; GLSL code may build mat4(m[0], m[1], m[2], m[3])
+//     but cameraToClip below spells the product out so that CPU and GPU
+//     evaluate it in the same order.
+#ifndef FIBSCOPE_SHADERS_SHARED_CAMERA_H
+#define FIBSCOPE_SHADERS_SHARED_CAMERA_H
+
+#include "shared/glsl_cpp.h"
+
+SHADER_NAMESPACE_BEGIN
+
+struct CameraBlock {
+  vec4 view_projection[4];  // world mm -> clip, columns
+  vec4 view[4];             // world mm -> view (eye at origin, looking down -z), columns
+  vec4 eye;                 // xyz: eye position in world mm; w = 1
+  vec4 viewport;            // x: width px, y: height px, z: line width px, w: 0
+  vec4 depth_range;         // x: near mm, y: far mm (view-space distances); z, w: 0
+};
+
+// Column-major 4x4 times (p, 1), summed column by column in a fixed order.
+SHADER_FN vec4 cameraTransformPoint(vec4 m[4], vec3 p) {
+  SHADER_PRECISE float x = ((m[0].x * p.x + m[1].x * p.y) + m[2].x * p.z) + m[3].x;
+  SHADER_PRECISE float y = ((m[0].y * p.x + m[1].y * p.y) + m[2].y * p.z) + m[3].y;
+  SHADER_PRECISE float z = ((m[0].z * p.x + m[1].z * p.y) + m[2].z * p.z) + m[3].z;
+  SHADER_PRECISE float w = ((m[0].w * p.x + m[1].w * p.y) + m[2].w * p.z) + m[3].w;
+  return vec4(x, y, z, w);
+}
+
+SHADER_NAMESPACE_END
+
+#ifdef __cplusplus
+static_assert(sizeof(fibscope::shader::CameraBlock) == 176, "camera block: 11 vec4, no padding");
+#endif
+
+#endif  // FIBSCOPE_SHADERS_SHARED_CAMERA_H

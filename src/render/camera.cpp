@@ -1,0 +1,179 @@
+#include "render/camera.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <string>
+
+#include "core/error.h"
+
+namespace fibscope {
+namespace {
+
+using Mat4d = std::array<double, 16>;
+
+Vec3d sub(Vec3d a, Vec3d b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+double dot(Vec3d a, Vec3d b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+Vec3d cross(Vec3d a, Vec3d b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+double length(Vec3d a) { return std::sqrt(dot(a, a)); }
+Vec3d scale(Vec3d a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
+
+double radians(double deg) { return deg * std::numbers::pi / 180.0; }
+
+Mat4 toFloat(const Mat4d& m) {
+  Mat4 out{};
+  for (size_t i = 0; i < 16; ++i) out[i] = static_cast<float>(m[i]);
+  return out;
+}
+
+Mat4d multiply(const Mat4d& a, const Mat4d& b) {  // a * b, column-major
+  Mat4d out{};
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r) {
+      double sum = 0;
+      for (int k = 0; k < 4; ++k) sum += a[4 * k + r] * b[4 * c + k];
+      out[4 * c + r] = sum;
+    }
+  return out;
+}
+
+}  // namespace
+
+void validateCamera(const Camera& camera) {
+  const Vec3d forward = sub(camera.target, camera.eye);
+  const double forward_length = length(forward);
+  if (!(forward_length > 0) || !std::isfinite(forward_length))
+    fail("camera", "eye and target must be distinct finite points");
+  const double up_length = length(camera.up);
+  if (!(up_length > 0) || !std::isfinite(up_length)) fail("camera", "up must be a finite non-zero vector");
+  // sin of the angle between up and the view direction.
+  if (length(cross(forward, camera.up)) <= 1e-9 * forward_length * up_length)
+    fail("camera", "up must not be parallel to the view direction");
+  if (!(camera.fov_y_deg > 0 && camera.fov_y_deg < 180))
+    fail("camera", "vertical field of view must lie in (0, 180) degrees, got " + std::to_string(camera.fov_y_deg));
+  if (!(camera.near_mm > 0) || !(camera.far_mm > camera.near_mm) || !std::isfinite(camera.far_mm))
+    fail("camera", "need 0 < near < far, got near " + std::to_string(camera.near_mm) + " far " +
+                       std::to_string(camera.far_mm));
+  if (camera.width == 0 || camera.height == 0) fail("camera", "image size must be at least 1 x 1");
+}
+
+std::array<double, 16> viewMatrixD(const Camera& camera) {
+  validateCamera(camera);
+  const Vec3d f = scale(sub(camera.target, camera.eye), 1.0 / length(sub(camera.target, camera.eye)));
+  Vec3d s = cross(f, camera.up);
+  s = scale(s, 1.0 / length(s));
+  const Vec3d u = cross(s, f);
+  // Rows: s, u, -f; translation moves the eye to the origin.
+  return {s[0], u[0], -f[0], 0,  //
+          s[1], u[1], -f[1], 0,  //
+          s[2], u[2], -f[2], 0,  //
+          -dot(s, camera.eye), -dot(u, camera.eye), dot(f, camera.eye), 1};
+}
+
+std::array<double, 16> projectionMatrixD(const Camera& camera) {
+  validateCamera(camera);
+  const double g = 1.0 / std::tan(radians(camera.fov_y_deg) / 2);
+  const double aspect = double(camera.width) / double(camera.height);
+  const double n = camera.near_mm, f = camera.far_mm;
+  Mat4d m{};
+  m[0] = g / aspect;
+  m[5] = -g;                  // y down: view +y (up) goes to the top row, y_ndc = -1
+  m[10] = f / (n - f);        // z_clip = (f z + n f) / (n - f): 0 at z = -n, w at z = -f
+  m[11] = -1;                 // w_clip = -z_view
+  m[14] = n * f / (n - f);
+  return m;
+}
+
+std::array<double, 16> viewProjectionD(const Camera& camera) {
+  return multiply(projectionMatrixD(camera), viewMatrixD(camera));
+}
+
+Mat4 viewMatrix(const Camera& camera) { return toFloat(viewMatrixD(camera)); }
+Mat4 projectionMatrix(const Camera& camera) { return toFloat(projectionMatrixD(camera)); }
+Mat4 viewProjection(const Camera& camera) { return toFloat(viewProjectionD(camera)); }
+
+shader::CameraBlock makeCameraBlock(const Camera& camera, float line_width_px) {
+  const Mat4 vp = viewProjection(camera);
+  const Mat4 v = viewMatrix(camera);
+  shader::CameraBlock block{};
+  for (int c = 0; c < 4; ++c) {
+    block.view_projection[c] = {vp[4 * c], vp[4 * c + 1], vp[4 * c + 2], vp[4 * c + 3]};
+    block.view[c] = {v[4 * c], v[4 * c + 1], v[4 * c + 2], v[4 * c + 3]};
+  }
+  block.eye = {float(camera.eye[0]), float(camera.eye[1]), float(camera.eye[2]), 1.0f};
+  block.viewport = {float(camera.width), float(camera.height), line_width_px, 0.0f};
+  block.depth_range = {float(camera.near_mm), float(camera.far_mm), 0.0f, 0.0f};
+  return block;
+}
+
+Bounds tractogramBounds(const Tractogram& tractogram) {
+  if (tractogram.pointCount() == 0) return {};
+  Bounds b;
+  b.min.fill(std::numeric_limits<double>::infinity());
+  b.max.fill(-std::numeric_limits<double>::infinity());
+  for (size_t i = 0; i < tractogram.pointCount(); ++i) {
+    const float* p = tractogram.point(i);
+    for (int k = 0; k < 3; ++k) {
+      b.min[k] = std::min(b.min[k], double(p[k]));
+      b.max[k] = std::max(b.max[k], double(p[k]));
+    }
+  }
+  return b;
+}
+
+Camera fitCamera(const Bounds& bounds, Vec3d direction, Vec3d up, uint32_t width, uint32_t height,
+                 double distance_factor, double fov_y_deg) {
+  const double direction_length = length(direction);
+  if (!(direction_length > 0)) fail("camera", "fit: view direction must be non-zero");
+  if (!(distance_factor > 0)) fail("camera", "fit: distance factor must be positive");
+  if (width == 0 || height == 0) fail("camera", "image size must be at least 1 x 1");
+  if (!(fov_y_deg > 0 && fov_y_deg < 180)) fail("camera", "fit: vertical field of view must lie in (0, 180)");
+  const Vec3d centre = {(bounds.min[0] + bounds.max[0]) / 2, (bounds.min[1] + bounds.max[1]) / 2,
+                        (bounds.min[2] + bounds.max[2]) / 2};
+  // A box of size 0 still gets a 1 mm sphere, so the matrices stay valid.
+  const double radius = std::max(length(sub(bounds.max, bounds.min)) / 2, 1.0);
+  const double half_fov_y = radians(fov_y_deg) / 2;
+  const double half_fov_x = std::atan(std::tan(half_fov_y) * double(width) / double(height));
+  // A sphere of radius r at distance d fills a cone of half-angle asin(r / d).
+  const double distance = distance_factor * radius / std::sin(std::min(half_fov_x, half_fov_y));
+  Camera camera;
+  camera.eye = {centre[0] + direction[0] / direction_length * distance,
+                centre[1] + direction[1] / direction_length * distance,
+                centre[2] + direction[2] / direction_length * distance};
+  camera.target = centre;
+  camera.up = up;
+  camera.fov_y_deg = fov_y_deg;
+  camera.far_mm = distance + radius * 1.01;
+  camera.near_mm = std::max(distance - radius * 1.01, distance * 1e-3);
+  camera.width = width;
+  camera.height = height;
+  validateCamera(camera);
+  return camera;
+}
+
+Camera orbitCamera(const Bounds& bounds, double azimuth_deg, double elevation_deg, uint32_t width,
+                   uint32_t height, double distance_factor, double fov_y_deg) {
+  const double az = radians(azimuth_deg), el = radians(elevation_deg);
+  const Vec3d direction = {std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el)};
+  // d(direction)/d(elevation): orthogonal to the direction, +z at elevation 0.
+  const Vec3d up = {-std::sin(el) * std::cos(az), -std::sin(el) * std::sin(az), std::cos(el)};
+  return fitCamera(bounds, direction, up, width, height, distance_factor, fov_y_deg);
+}
+
+Camera standardView(const Bounds& bounds, StandardView view, uint32_t width, uint32_t height,
+                    double distance_factor, double fov_y_deg) {
+  switch (view) {
+    case StandardView::Sagittal:
+      return fitCamera(bounds, {1, 0, 0}, {0, 0, 1}, width, height, distance_factor, fov_y_deg);
+    case StandardView::Coronal:
+      return fitCamera(bounds, {0, 1, 0}, {0, 0, 1}, width, height, distance_factor, fov_y_deg);
+    case StandardView::Axial:
+      return fitCamera(bounds, {0, 0, 1}, {0, 1, 0}, width, height, distance_factor, fov_y_deg);
+  }
+  fail("camera", "unknown standard view");
+}
+
+}  // namespace fibscope
