@@ -8,8 +8,9 @@
 //                        GPU's log-step prefix (log2(59) = 6 compose rounds
 //                        over all lanes, so more work than sequential)
 //   CodecMeasureError    decode + world-space comparison (codec_error)
-//   CodecEncodeThreads/T closed-loop encode of chunks of 200 fibers on T
-//                        threads (the compressor's pool), wall-clock rate
+//   CodecEncodeThreads/T/M closed-loop encode of chunks of 200 fibers on T
+//                        threads (the compressor's pool), wall-clock rate;
+//                        M = 1 measures every point's error as compress does
 //   FblDecompressToPoints/order  an .fbl of the phantom read back through
 //                        openFbl into world-space float points (checksums,
 //                        table checks, decode, toWorld): what `decompress`
@@ -105,7 +106,12 @@ void CodecEncodeThreads(benchmark::State& state) {
     chunks.push_back(std::move(c));
   }
   std::vector<std::unique_ptr<FibletEncoder>> encoders;
-  for (unsigned w = 0; w < threads; ++w) encoders.push_back(std::make_unique<FibletEncoder>(params));
+  std::vector<CodecErrorMeter> meters(threads);
+  for (unsigned w = 0; w < threads; ++w) {
+    encoders.push_back(std::make_unique<FibletEncoder>(params));
+    // As the compressor runs them: measuring every point.
+    if (state.range(1)) encoders.back()->setErrorMeter(&meters[w]);
+  }
   std::vector<EncodedFiblets> out(chunks.size());
   ThreadPool pool(threads);
   for (auto _ : state) {
@@ -121,7 +127,14 @@ void CodecEncodeThreads(benchmark::State& state) {
   }
   state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(t.pointCount()));
 }
-BENCHMARK(CodecEncodeThreads)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(CodecEncodeThreads)
+    ->ArgNames({"threads", "measure"})
+    ->Args({1, 0})
+    ->Args({2, 0})
+    ->Args({1, 1})
+    ->Args({2, 1})
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
 
 void FblDecompressToPoints(benchmark::State& state) {
   static const std::string path = [] {

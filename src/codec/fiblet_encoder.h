@@ -105,6 +105,7 @@ class FibletEncoder {
   struct Lane {
     std::vector<double> target;  // the fiber in normalised space
     std::vector<uint8_t> bytes;  // records of the fibers this lane encoded
+    std::vector<V4f> decoded;    // with a meter: the fiber's decoded points (normalised)
     size_t fiber = 0, n = 0;     // which fiber of the chunk, its point count
     size_t fiber_offset = 0;     // where its records start in bytes
     uint32_t fiber_fiblets = 0;
@@ -131,7 +132,8 @@ class FibletEncoder {
   bool finishFiblet(Lane& lane);
   void emit(const Lane& lane, size_t offset, uint32_t fiblets, uint32_t points, EncodedFiblets& out);
   void checkOutput(EncodedFiblets& out) const;
-  void measure(const Lane& lane, V4f decoded, size_t index);
+  // Adds the errors of the lane's finished fiber to the meter.
+  void measureFiber(const Lane& lane);
   // Records the turn at interior point j of the lane's fiber.
   void noteTurn(const Lane& lane, size_t j);
   // Records a turn given as dot(prev, seg), |seg|^2 and |prev|^2.
@@ -159,7 +161,7 @@ class FibletEncoder {
   std::array<Frame4, shader::kFibletCodeCount> local4_;
   EncodeReport report_;
   CodecErrorMeter* meter_ = nullptr;
-  double um_per_unit_;  // world micrometres per normalised unit
+  double um2_per_unit2_;  // (world micrometres per normalised unit)^2
   shader::vec3 v_;
   double len2_lo_, len2_hi_;     // accepted squared step lengths (step_tolerance)
   double cos_alpha_, cos2_alpha_;
