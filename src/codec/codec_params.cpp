@@ -71,14 +71,21 @@ double turnDegrees(double tan2) {
 void CodecParamEstimator::add(const Tractogram& chunk) {
   // Every point enters the bounding box (exact); only sampled segments are
   // measured (see SegmentSample).
+  // In locals: the members could alias the points for the compiler, which
+  // then kept them in memory (a store-to-load chain per point).
   const float* p = chunk.positions.data();
+  float lx = lo_f_[0], ly = lo_f_[1], lz = lo_f_[2], hx = hi_f_[0], hy = hi_f_[1], hz = hi_f_[2];
   for (size_t i = 0, n = chunk.pointCount(); i < n; ++i, p += 3) {
     // NaN compares false and stays out of the box.
-    for (int c = 0; c < 3; ++c) {
-      lo_f_[c] = p[c] < lo_f_[c] ? p[c] : lo_f_[c];
-      hi_f_[c] = p[c] > hi_f_[c] ? p[c] : hi_f_[c];
-    }
+    lx = p[0] < lx ? p[0] : lx;
+    ly = p[1] < ly ? p[1] : ly;
+    lz = p[2] < lz ? p[2] : lz;
+    hx = p[0] > hx ? p[0] : hx;
+    hy = p[1] > hy ? p[1] : hy;
+    hz = p[2] > hz ? p[2] : hz;
   }
+  lo_f_ = {lx, ly, lz};
+  hi_f_ = {hx, hy, hz};
   const float nan = std::numeric_limits<float>::quiet_NaN();
   for (size_t s = 0; s < chunk.streamlineCount(); ++s) {
     const size_t first = chunk.offsets[s], n = chunk.pointsIn(s);

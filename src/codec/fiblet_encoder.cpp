@@ -129,8 +129,14 @@ void FibletEncoder::startFiber(Lane& lane, const float* xyz, size_t n) {
   if (n == 1) ++report_.single_point_fibers;
   if (n == 2) ++report_.two_point_fibers;
   lane.target.resize(3 * n);
-  for (size_t i = 0; i < 3 * n; ++i)
-    lane.target[i] = (double(xyz[i]) - double(params_.translation[i % 3])) * double(params_.scale);
+  const double tx = params_.translation[0], ty = params_.translation[1], tz = params_.translation[2];
+  const double scale = params_.scale;
+  double* out = lane.target.data();
+  for (size_t i = 0; i < n; ++i, xyz += 3, out += 3) {
+    out[0] = (double(xyz[0]) - tx) * scale;
+    out[1] = (double(xyz[1]) - ty) * scale;
+    out[2] = (double(xyz[2]) - tz) * scale;
+  }
   lane.n = n;
   if (meter_) lane.decoded.resize(n);
   lane.first = 0;
