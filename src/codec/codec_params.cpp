@@ -1,6 +1,9 @@
 #include "codec/codec_params.h"
 
 #include <algorithm>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -74,15 +77,53 @@ void CodecParamEstimator::add(const Tractogram& chunk) {
   // In locals: the members could alias the points for the compiler, which
   // then kept them in memory (a store-to-load chain per point).
   const float* p = chunk.positions.data();
+  const size_t n = chunk.pointCount();
   float lx = lo_f_[0], ly = lo_f_[1], lz = lo_f_[2], hx = hi_f_[0], hy = hi_f_[1], hz = hi_f_[2];
-  for (size_t i = 0, n = chunk.pointCount(); i < n; ++i, p += 3) {
+  size_t i = 0;
+#if defined(__SSE2__)
+  // Four points are three vectors (x y z x | y z x y | z x y z): one min and
+  // one max per vector, with the lanes' components folded at the end. MINPS
+  // returns its second operand when either is NaN, so a NaN point never
+  // enters the box (the accumulator is the second operand).
+  if (n >= 4) {
+    __m128 lo[3], hi[3];
+    for (int v = 0; v < 3; ++v) lo[v] = hi[v] = _mm_loadu_ps(p + 4 * v);
+    for (int v = 0; v < 3; ++v) {
+      // A NaN in the first four points must not seed the accumulators.
+      const __m128 finite = _mm_cmpord_ps(lo[v], lo[v]);
+      const __m128 seed_lo = _mm_set1_ps(std::numeric_limits<float>::infinity());
+      lo[v] = _mm_or_ps(_mm_and_ps(finite, lo[v]), _mm_andnot_ps(finite, seed_lo));
+      hi[v] = _mm_or_ps(_mm_and_ps(finite, hi[v]), _mm_andnot_ps(finite, _mm_sub_ps(_mm_setzero_ps(), seed_lo)));
+    }
+    for (i = 4; i + 4 <= n; i += 4) {
+      for (int v = 0; v < 3; ++v) {
+        const __m128 x = _mm_loadu_ps(p + 3 * i + 4 * v);
+        lo[v] = _mm_min_ps(x, lo[v]);
+        hi[v] = _mm_max_ps(x, hi[v]);
+      }
+    }
+    float l[12], h[12];
+    for (int v = 0; v < 3; ++v) {
+      _mm_storeu_ps(l + 4 * v, lo[v]);
+      _mm_storeu_ps(h + 4 * v, hi[v]);
+    }
+    // Lane k of the 12 holds component k % 3.
+    for (int k = 0; k < 12; ++k) {
+      float& lc = k % 3 == 0 ? lx : (k % 3 == 1 ? ly : lz);
+      float& hc = k % 3 == 0 ? hx : (k % 3 == 1 ? hy : hz);
+      lc = l[k] < lc ? l[k] : lc;
+      hc = h[k] > hc ? h[k] : hc;
+    }
+  }
+#endif
+  for (const float* q = p + 3 * i; i < n; ++i, q += 3) {
     // NaN compares false and stays out of the box.
-    lx = p[0] < lx ? p[0] : lx;
-    ly = p[1] < ly ? p[1] : ly;
-    lz = p[2] < lz ? p[2] : lz;
-    hx = p[0] > hx ? p[0] : hx;
-    hy = p[1] > hy ? p[1] : hy;
-    hz = p[2] > hz ? p[2] : hz;
+    lx = q[0] < lx ? q[0] : lx;
+    ly = q[1] < ly ? q[1] : ly;
+    lz = q[2] < lz ? q[2] : lz;
+    hx = q[0] > hx ? q[0] : hx;
+    hy = q[1] > hy ? q[1] : hy;
+    hz = q[2] > hz ? q[2] : hz;
   }
   lo_f_ = {lx, ly, lz};
   hi_f_ = {hx, hy, hz};

@@ -389,6 +389,38 @@ TEST(Compressor, blockSizesTwoAndThreeGiveTheSameErrorsAndOneIsWorse) {
   EXPECT_GT(by_size[1].error.mean_um, by_size[2].error.mean_um);
 }
 
+TEST(FibletParams, boundingBoxIsExactWhateverTheChunkSizesAndNaNs) {
+  // The vectorised box (four points at a time) against brute force, with
+  // NaN points in the first four, the middle and the tail.
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(-80, 80);
+  for (int trial = 0; trial < 50; ++trial) {
+    CodecParamEstimator estimator;
+    double lo[3] = {1e30, 1e30, 1e30}, hi[3] = {-1e30, -1e30, -1e30};
+    for (int chunk_index = 0; chunk_index < 3; ++chunk_index) {
+      Tractogram chunk;
+      const size_t points = 2 + rng() % 23;
+      std::vector<float> xyz;
+      for (size_t i = 0; i < points; ++i) {
+        for (int c = 0; c < 3; ++c) {
+          float v = u(rng);
+          if (rng() % 9 == 0) v = std::nanf("");
+          xyz.push_back(v);
+          if (!std::isnan(v)) {
+            lo[c] = std::min(lo[c], double(v));
+            hi[c] = std::max(hi[c], double(v));
+          }
+        }
+      }
+      chunk.addStreamline(xyz.data(), points);
+      estimator.add(chunk);
+    }
+    const CodecParamSummary s = estimator.summary();
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(double(s.params.translation[c]), lo[c]) << trial;
+    EXPECT_DOUBLE_EQ(s.extent_mm, std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]})) << trial;
+  }
+}
+
 TEST(ThreadPool, runsEveryJobOnItsWorkersAndPassesExceptionsToTheCaller) {
   ThreadPool pool(3);
   EXPECT_EQ(pool.size(), 3u);
