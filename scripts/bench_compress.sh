@@ -7,8 +7,9 @@
 #
 # Writes DATA_DIR/small.tck and DATA_DIR/large.tck with `fibscope phantom`
 # (0.1 mm, seed 21; defaults 190000 and 760000 fibers, about 2 GB and 8 GB)
-# unless they exist, then compresses each twice (the first run warms the
-# page cache; the second is reported). Peak RSS from /usr/bin/time -v. The
+# unless they exist, then compresses each 1 + RUNS times (default RUNS=3;
+# the first run warms the page cache) and reports the median run by
+# throughput, with the largest peak RSS of the runs (/usr/bin/time -v). The
 # large file needs ~9 GB of disk and is read twice, so it should fit in the
 # page cache (or the figure is disk speed).
 set -euo pipefail
@@ -35,14 +36,21 @@ for name in small large; do
   out=$data/$name.fbl
   "$fibscope" compress "$in" "$out" --force >/dev/null
   log=$(mktemp)
-  /usr/bin/time -v "$fibscope" compress "$in" "$out" --force --json >"$log.json" 2>"$log"
-  rss_kb=$(sed -n 's/^\s*Maximum resident set size (kbytes): //p' "$log")
-  /usr/bin/python3 - "$log.json" "$name" "$rss_kb" "$(stat -c %s "$in")" <<'PY'
-import json, sys
-r = json.load(open(sys.argv[1]))
-print('%-10s %14d %12d %8.3f %12.1f %10.2f %10.2f %10.2f %12.1f' % (
-    sys.argv[2], r['points'], int(sys.argv[4]), r['bytes_per_point'], r['points_per_second'] / 1e6,
-    r['error_um']['max'], r['error_um']['mean'], r['seconds']['total'], int(sys.argv[3]) / 1024))
+  for run in $(seq "${RUNS:-3}"); do
+    /usr/bin/time -v "$fibscope" compress "$in" "$out" --force --json >"$log.$run.json" 2>"$log.$run"
+  done
+  /usr/bin/python3 - "$log" "${RUNS:-3}" "$name" "$(stat -c %s "$in")" <<'PY'
+import json, re, sys
+log, runs, name, size = sys.argv[1], int(sys.argv[2]), sys.argv[3], int(sys.argv[4])
+reports = [json.load(open('%s.%d.json' % (log, r))) for r in range(1, runs + 1)]
+rss = max(int(re.search(r'Maximum resident set size \(kbytes\): (\d+)', open('%s.%d' % (log, r)).read()).group(1))
+          for r in range(1, runs + 1))
+reports.sort(key=lambda r: r['points_per_second'])
+r = reports[len(reports) // 2]
+rates = ', '.join('%.1f' % (x['points_per_second'] / 1e6) for x in reports)
+print('%-10s %14d %12d %8.3f %12.1f %10.2f %10.2f %10.2f %12.1f   (runs: %s)' % (
+    name, r['points'], size, r['bytes_per_point'], r['points_per_second'] / 1e6,
+    r['error_um']['max'], r['error_um']['mean'], r['seconds']['total'], rss / 1024, rates))
 PY
-  rm -f "$log" "$log.json"
+  rm -f "$log" "$log".*
 done
