@@ -21,9 +21,9 @@
 
 #include "codec/codec_error.h"
 #include "codec/codec_params.h"
-#include "codec/fiblet_decoder.h"
 #include "codec/compressor.h"
 #include "codec/fbl_reader.h"
+#include "codec/fiblet_decoder.h"
 #include "codec/fiblet_encoder.h"
 #include "core/thread_pool.h"
 #include "phantom/phantom.h"
@@ -102,7 +102,8 @@ void CodecEncodeThreads(benchmark::State& state) {
   std::vector<Tractogram> chunks;
   for (size_t s = 0; s < t.streamlineCount(); s += 200) {
     Tractogram c;
-    for (size_t i = s; i < std::min(s + 200, t.streamlineCount()); ++i) c.addStreamline(t.point(t.offsets[i]), t.pointsIn(i));
+    for (size_t i = s; i < std::min(s + 200, t.streamlineCount()); ++i)
+      c.addStreamline(t.point(t.offsets[i]), t.pointsIn(i));
     chunks.push_back(std::move(c));
   }
   std::vector<std::unique_ptr<FibletEncoder>> encoders;
@@ -138,7 +139,8 @@ BENCHMARK(CodecEncodeThreads)
 
 void FblDecompressToPoints(benchmark::State& state) {
   static const std::string path = [] {
-    const std::string p = std::string(std::getenv("TMPDIR") ? std::getenv("TMPDIR") : "/tmp") + "/fibscope_codec_bench.fbl";
+    const std::string p =
+        std::string(std::getenv("TMPDIR") ? std::getenv("TMPDIR") : "/tmp") + "/fibscope_codec_bench.fbl";
     CompressOptions options;
     options.terminal_progress = false;
     options.overwrite = true;

@@ -31,10 +31,11 @@ std::string modeName(const CompressReport& r, int side) {
 
 void printReport(const CompressReport& r, int side, bool full) {
   const CodecParams& p = r.analysis.params;
-  std::printf("wrote %s: %llu fibers, %llu points, %llu fiblets, %s (%.3f bytes/point); error max %.2f um, mean %.2f um\n",
-              r.output.c_str(), static_cast<unsigned long long>(r.fibers), static_cast<unsigned long long>(r.points),
-              static_cast<unsigned long long>(r.fiblets), formatBytes(double(r.output_bytes)).c_str(),
-              r.bytesPerPoint(), r.error.max_um, r.error.mean_um);
+  std::printf(
+      "wrote %s: %llu fibers, %llu points, %llu fiblets, %s (%.3f bytes/point); error max %.2f um, mean %.2f um\n",
+      r.output.c_str(), static_cast<unsigned long long>(r.fibers), static_cast<unsigned long long>(r.points),
+      static_cast<unsigned long long>(r.fiblets), formatBytes(double(r.output_bytes)).c_str(), r.bytesPerPoint(),
+      r.error.max_um, r.error.mean_um);
   if (!full) return;
   std::printf("  input       %s (%s, %s)\n", r.input.c_str(), r.input_format.c_str(),
               formatBytes(double(r.input_bytes)).c_str());
@@ -42,13 +43,15 @@ void printReport(const CompressReport& r, int side, bool full) {
               static_cast<unsigned long long>(r.output_bytes), static_cast<unsigned long long>(r.fiblet_bytes),
               static_cast<unsigned long long>(r.output_bytes - r.fiblet_bytes), r.bytesPerPoint(), r.ratio());
   std::printf("  step        %.6g mm (%s)\n", p.deltaMm(),
-              r.analysis.delta_measured ? ("median of " + std::to_string(r.analysis.sampled_steps) + " sampled steps").c_str()
-                                        : "given");
+              r.analysis.delta_measured
+                  ? ("median of " + std::to_string(r.analysis.sampled_steps) + " sampled steps").c_str()
+                  : "given");
   if (r.analysis.alpha_measured)
-    std::printf("  alpha       %.3f deg = 1.1 x the 99.9th percentile turn (%.3f deg, of %llu sampled turns), clamped to "
-                "[1, 90]; largest turn %.2f deg\n",
-                degrees(p.alpha), r.analysis.turn_percentile_deg,
-                static_cast<unsigned long long>(r.analysis.sampled_turns), r.analysis.max_turn_deg);
+    std::printf(
+        "  alpha       %.3f deg = 1.1 x the 99.9th percentile turn (%.3f deg, of %llu sampled turns), clamped to "
+        "[1, 90]; largest turn %.2f deg\n",
+        degrees(p.alpha), r.analysis.turn_percentile_deg, static_cast<unsigned long long>(r.analysis.sampled_turns),
+        r.analysis.max_turn_deg);
   else
     std::printf("  alpha       %.3f deg (given); largest turn %.2f deg\n", degrees(p.alpha), r.analysis.max_turn_deg);
   std::printf("  fiblets     N = %u points (%u-byte records), %s, %u threads\n", p.points_per_fiblet, p.recordBytes(),
@@ -57,18 +60,20 @@ void printReport(const CompressReport& r, int side, bool full) {
               r.error.max_um, r.error.mean_um, r.error.p99_um, r.error.rms_um,
               static_cast<unsigned long long>(r.error.points));
   const EncodeReport& e = r.encode;
-  std::printf("  exceptions  %llu turns above alpha, %llu steps off the step by > 5%%, %llu closed-loop error splits "
-              "(each starts a fiblet); %llu one-point and %llu two-point fibers; %llu points clamped into the box\n",
-              static_cast<unsigned long long>(e.angle_splits), static_cast<unsigned long long>(e.step_splits),
-              static_cast<unsigned long long>(e.error_splits), static_cast<unsigned long long>(e.single_point_fibers),
-              static_cast<unsigned long long>(e.two_point_fibers), static_cast<unsigned long long>(e.clamped_points));
+  std::printf(
+      "  exceptions  %llu turns above alpha, %llu steps off the step by > 5%%, %llu closed-loop error splits "
+      "(each starts a fiblet); %llu one-point and %llu two-point fibers; %llu points clamped into the box\n",
+      static_cast<unsigned long long>(e.angle_splits), static_cast<unsigned long long>(e.step_splits),
+      static_cast<unsigned long long>(e.error_splits), static_cast<unsigned long long>(e.single_point_fibers),
+      static_cast<unsigned long long>(e.two_point_fibers), static_cast<unsigned long long>(e.clamped_points));
   if (r.resampled)
-    std::printf("  resampled   %llu -> %llu points (%llu moved); input points lie within max %.3f um, mean %.3f um of "
-                "the resampled fibers (the error above is against the resampled points)\n",
-                static_cast<unsigned long long>(r.resample.input_points),
-                static_cast<unsigned long long>(r.resample.output_points),
-                static_cast<unsigned long long>(r.resample.moved_points), 1000 * r.resample.max_deviation_mm,
-                1000 * r.resample.mean_deviation_mm);
+    std::printf(
+        "  resampled   %llu -> %llu points (%llu moved); input points lie within max %.3f um, mean %.3f um of "
+        "the resampled fibers (the error above is against the resampled points)\n",
+        static_cast<unsigned long long>(r.resample.input_points),
+        static_cast<unsigned long long>(r.resample.output_points),
+        static_cast<unsigned long long>(r.resample.moved_points), 1000 * r.resample.max_deviation_mm,
+        1000 * r.resample.mean_deviation_mm);
   for (const std::string& d : r.dropped) std::printf("  not stored  %s\n", d.c_str());
   std::printf("  time        %.2f s (analyse %.2f s, encode and write %.2f s): %s points/s\n", r.seconds(),
               r.analyse_seconds, r.encode_seconds, formatCount(r.pointsPerSecond()).c_str());
@@ -85,18 +90,17 @@ nlohmann::json reportJson(const CompressReport& r, int side) {
   j["fiblets"] = r.fiblets;
   j["bytes_per_point"] = r.bytesPerPoint();
   j["ratio"] = r.ratio();
-  j["params"] = {{"points_per_fiblet", p.points_per_fiblet},
-                 {"step_mm", p.deltaMm()},
-                 {"step_measured", r.analysis.delta_measured},
-                 {"alpha_deg", degrees(p.alpha)},
-                 {"alpha_measured", r.analysis.alpha_measured},
-                 {"turn_p99_9_deg", r.analysis.turn_percentile_deg},
-                 {"max_turn_deg", r.analysis.max_turn_deg},
-                 {"steps_off_fraction", r.analysis.steps_off_fraction}};
+  j["params"] = {{"points_per_fiblet", p.points_per_fiblet},    {"step_mm", p.deltaMm()},
+                 {"step_measured", r.analysis.delta_measured},  {"alpha_deg", degrees(p.alpha)},
+                 {"alpha_measured", r.analysis.alpha_measured}, {"turn_p99_9_deg", r.analysis.turn_percentile_deg},
+                 {"max_turn_deg", r.analysis.max_turn_deg},     {"steps_off_fraction", r.analysis.steps_off_fraction}};
   j["mode"] = modeName(r, side);
   j["threads"] = r.threads;
-  j["error_um"] = {{"max", r.error.max_um}, {"mean", r.error.mean_um}, {"p99", r.error.p99_um},
-                   {"rms", r.error.rms_um}, {"points", r.error.points}};
+  j["error_um"] = {{"max", r.error.max_um},
+                   {"mean", r.error.mean_um},
+                   {"p99", r.error.p99_um},
+                   {"rms", r.error.rms_um},
+                   {"points", r.error.points}};
   j["exceptions"] = {{"angle_splits", e.angle_splits},         {"step_splits", e.step_splits},
                      {"error_splits", e.error_splits},         {"single_point_fibers", e.single_point_fibers},
                      {"two_point_fibers", e.two_point_fibers}, {"clamped_points", e.clamped_points}};

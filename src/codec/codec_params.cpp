@@ -77,15 +77,15 @@ void CodecParamEstimator::add(const Tractogram& chunk) {
   // In locals: the members could alias the points for the compiler, which
   // then kept them in memory (a store-to-load chain per point).
   const float* p = chunk.positions.data();
-  const size_t n = chunk.pointCount();
+  const size_t count = chunk.pointCount();
   float lx = lo_f_[0], ly = lo_f_[1], lz = lo_f_[2], hx = hi_f_[0], hy = hi_f_[1], hz = hi_f_[2];
-  size_t i = 0;
+  size_t next = 0;  // the first point not yet in the box
 #if defined(__SSE2__)
   // Four points are three vectors (x y z x | y z x y | z x y z): one min and
   // one max per vector, with the lanes' components folded at the end. MINPS
   // returns its second operand when either is NaN, so a NaN point never
   // enters the box (the accumulator is the second operand).
-  if (n >= 4) {
+  if (count >= 4) {
     __m128 lo[3], hi[3];
     for (int v = 0; v < 3; ++v) lo[v] = hi[v] = _mm_loadu_ps(p + 4 * v);
     for (int v = 0; v < 3; ++v) {
@@ -95,9 +95,9 @@ void CodecParamEstimator::add(const Tractogram& chunk) {
       lo[v] = _mm_or_ps(_mm_and_ps(finite, lo[v]), _mm_andnot_ps(finite, seed_lo));
       hi[v] = _mm_or_ps(_mm_and_ps(finite, hi[v]), _mm_andnot_ps(finite, _mm_sub_ps(_mm_setzero_ps(), seed_lo)));
     }
-    for (i = 4; i + 4 <= n; i += 4) {
+    for (next = 4; next + 4 <= count; next += 4) {
       for (int v = 0; v < 3; ++v) {
-        const __m128 x = _mm_loadu_ps(p + 3 * i + 4 * v);
+        const __m128 x = _mm_loadu_ps(p + 3 * next + 4 * v);
         lo[v] = _mm_min_ps(x, lo[v]);
         hi[v] = _mm_max_ps(x, hi[v]);
       }
@@ -116,7 +116,7 @@ void CodecParamEstimator::add(const Tractogram& chunk) {
     }
   }
 #endif
-  for (const float* q = p + 3 * i; i < n; ++i, q += 3) {
+  for (const float* q = p + 3 * next; next < count; ++next, q += 3) {
     // NaN compares false and stays out of the box.
     lx = q[0] < lx ? q[0] : lx;
     ly = q[1] < ly ? q[1] : ly;

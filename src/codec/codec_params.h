@@ -18,7 +18,7 @@ struct CodecParams {
   // angles and the step are the same in both spaces).
   std::array<float, 3> translation = {0, 0, 0};
   float scale = 1.0f;
-  float delta = 0.001f;  // step in normalised units (delta_mm * scale)
+  float delta = 0.001f;       // step in normalised units (delta_mm * scale)
   float alpha = 0.26179939f;  // maximum turn between segments, radians (0 < alpha <= pi/2)
   // The constant vector of the local frames. It lies on the equator of the
   // local frame (z = 0) while every code direction has z > 0.06, so it is
@@ -63,8 +63,8 @@ struct CodecParamSummary {
   // `step_tolerance` (the encoder's split threshold): resampled or
   // compressed inputs have many.
   double steps_off_fraction = 0;
-  double extent_mm = 0;        // largest side of the bounding box
-  bool alpha_measured = false; // false when given
+  double extent_mm = 0;         // largest side of the bounding box
+  bool alpha_measured = false;  // false when given
   bool delta_measured = false;
 };
 

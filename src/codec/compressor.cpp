@@ -21,16 +21,14 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double secondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
+double secondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 // One chunk of fibers on its way through a worker.
 struct ChunkJob {
   std::string source;  // the input path, for messages
   Tractogram input;
-  EncodedFiblets fiblets;     // fiblet indices local to the chunk (fiblet_base 0)
-  std::vector<float> lengths; // arc length of each input fiber, mm
+  EncodedFiblets fiblets;      // fiblet indices local to the chunk (fiblet_base 0)
+  std::vector<float> lengths;  // arc length of each input fiber, mm
   uint64_t encoded_points = 0;
   ResampleReport resample;
 };
@@ -60,7 +58,8 @@ void encodeChunk(FibletEncoder& encoder, ChunkJob& job, bool resample, double de
                              std::to_string(kFblMaxFiberPoints) + " a .fbl fiber may hold");
   };
   job.lengths.resize(in.streamlineCount());
-  for (size_t s = 0; s < in.streamlineCount(); ++s) job.lengths[s] = polylineLength(in.point(in.offsets[s]), in.pointsIn(s));
+  for (size_t s = 0; s < in.streamlineCount(); ++s)
+    job.lengths[s] = polylineLength(in.point(in.offsets[s]), in.pointsIn(s));
   job.fiblets.record_bytes = encoder.decoder().params().recordBytes();
   if (resample) {
     const Tractogram resampled = resampleToStep(in, delta_mm, &job.resample);
@@ -243,7 +242,8 @@ CompressReport compressTractogram(const ReaderFactory& open_input, const std::st
       const bool resample = options.resample;
       in_flight.emplace_back(pool.submit([&encoders, job, resample, delta_mm](unsigned worker) {
         encodeChunk(*encoders[worker], *job, resample, delta_mm);
-      }), job);
+      }),
+                             job);
       // Read ahead by one chunk per worker plus one: enough to keep every
       // worker busy, bounded whatever the input size.
       if (in_flight.size() > threads + 1) writeOldest();

@@ -33,14 +33,14 @@ struct CompressOptions {
   // Resample every fiber to the step delta along its arc length before
   // encoding (for inputs whose steps vary: resampled or compressed files).
   bool resample = false;
-  unsigned threads = 0;               // encoding threads; 0 = one per core
+  unsigned threads = 0;  // encoding threads; 0 = one per core
   // Points per chunk handed to a worker. Small enough that the few chunks
   // in flight touch little fresh memory (first touches of pages cost ~5 us
   // each on the VMs measured), large enough to amortise the hand-over.
   size_t chunk_points = size_t(1) << 18;
   bool overwrite = false;
-  bool terminal_progress = true;      // progress bars on stderr (when a terminal)
-  Progress::Sink progress_sink;       // and/or to the viewer
+  bool terminal_progress = true;  // progress bars on stderr (when a terminal)
+  Progress::Sink progress_sink;   // and/or to the viewer
 };
 
 struct CompressReport {
@@ -52,10 +52,10 @@ struct CompressReport {
   CodecParamSummary analysis;  // includes the parameters used
   EncodeMode mode = EncodeMode::ClosedLoop;
   unsigned threads = 1;
-  EncodeReport encode;         // exceptions: splits, short fibers, clamped points
-  CodecErrorStats error;       // decoded points against the encoded ones, um
+  EncodeReport encode;    // exceptions: splits, short fibers, clamped points
+  CodecErrorStats error;  // decoded points against the encoded ones, um
   bool resampled = false;
-  ResampleReport resample;     // what resampling moved, when resampled
+  ResampleReport resample;            // what resampling moved, when resampled
   std::vector<std::string> dropped;   // input data not stored (per-point arrays, groups, ...)
   std::vector<std::string> warnings;  // reader warnings and the encoder's advice
   double analyse_seconds = 0, encode_seconds = 0;

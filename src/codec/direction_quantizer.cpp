@@ -16,9 +16,7 @@ namespace {
 DirectionGrid gridOf(double ox, double oy) { return {(ox + oy + 1.0) * 8.0, (ox - oy + 1.0) * 8.0}; }
 
 // floor(c) clamped to [0, limit] (NaN -> 0).
-uint32_t clampedFloor(double c, uint32_t limit) {
-  return c >= double(limit) ? limit : (c > 0 ? uint32_t(c) : 0u);
-}
+uint32_t clampedFloor(double c, uint32_t limit) { return c >= double(limit) ? limit : (c > 0 ? uint32_t(c) : 0u); }
 
 }  // namespace
 
@@ -54,7 +52,9 @@ DirectionGrid encodeDirectionGrid(const double direction[3], double alpha) {
   return gridOf(hx / s, hy / s);
 }
 
-uint32_t encodeDirection(const double direction[3], double alpha) { return cellOf(encodeDirectionGrid(direction, alpha)); }
+uint32_t encodeDirection(const double direction[3], double alpha) {
+  return cellOf(encodeDirectionGrid(direction, alpha));
+}
 
 FastDirectionQuantizer::FastDirectionQuantizer(double alpha, double step)
     : sin2_alpha_(std::pow(std::sin(alpha), 2)),

@@ -59,7 +59,8 @@ std::string validateFiblets(const EncodedFiblets& f, const CodecParams& params) 
       const std::string at = "fiblet " + std::to_string(i) + ": ";
       if (c < 1 || c > n) return at + "point count " + std::to_string(c) + " outside [1, " + std::to_string(n) + "]";
       if (((flags & shader::kFibletFlagBegins) != 0) != (i == first))
-        return at + "begins-fiber flag " + std::to_string(flags & 1) + " where " + (i == first ? "1" : "0") + " expected";
+        return at + "begins-fiber flag " + std::to_string(flags & 1) + " where " + (i == first ? "1" : "0") +
+               " expected";
       if (((flags & shader::kFibletFlagEnds) != 0) != (i + 1 == last))
         return at + "ends-fiber flag wrong for " + where.substr(0, where.size() - 2);
       points += c;
@@ -69,8 +70,7 @@ std::string validateFiblets(const EncodedFiblets& f, const CodecParams& params) 
              std::to_string(f.fiber_points[fiber]);
     expected_first = last;
   }
-  if (expected_first != end)
-    return std::to_string(end - expected_first) + " fiblets after the last fiber";
+  if (expected_first != end) return std::to_string(end - expected_first) + " fiblets after the last fiber";
   return "";
 }
 
@@ -147,10 +147,10 @@ uint32_t FibletDecoder::decodeScan(const uint8_t* record, float* xyz) const {
 }
 
 Tractogram FibletDecoder::decodeAll(const EncodedFiblets& fiblets, DecodeOrder order) const {
-  if (const std::string problem = validateFiblets(fiblets, params_); !problem.empty())
-    fail("fiblets", problem);
+  if (const std::string problem = validateFiblets(fiblets, params_); !problem.empty()) fail("fiblets", problem);
   Tractogram out;
-  out.positions.reserve(3 * size_t(std::accumulate(fiblets.fiber_points.begin(), fiblets.fiber_points.end(), uint64_t(0))));
+  out.positions.reserve(3 *
+                        size_t(std::accumulate(fiblets.fiber_points.begin(), fiblets.fiber_points.end(), uint64_t(0))));
   out.offsets.reserve(fiblets.fiberCount() + 1);
   std::array<float, 3 * shader::kFibletMaxPoints> xyz;
   for (size_t i = 0; i < fiblets.fibletCount(); ++i) {

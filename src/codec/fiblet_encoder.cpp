@@ -1,8 +1,8 @@
 #include "codec/fiblet_encoder.h"
 
 #include <algorithm>
-#include <cstring>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <numbers>
 #include <string>
@@ -81,7 +81,10 @@ void FibletEncoder::noteTurn(const Lane& lane, size_t j) {
 }
 
 FibletEncoder::FibletEncoder(const CodecParams& params, const EncodeOptions& options)
-    : params_(params), options_(options), decoder_(params), quantizer_(params.alpha, params.delta),
+    : params_(params),
+      options_(options),
+      decoder_(params),
+      quantizer_(params.alpha, params.delta),
       um2_per_unit2_(std::pow(1000.0 / double(params.scale), 2)) {
   v_ = vec3(params.v[0], params.v[1], params.v[2]);
   const double delta = params.delta;
@@ -374,8 +377,9 @@ double pointSegmentDistance(const float* p, const double a[3], const double b[3]
 void ResampleReport::merge(const ResampleReport& other) {
   const uint64_t measured = measured_points + other.measured_points;
   if (measured > 0)
-    mean_deviation_mm = (mean_deviation_mm * double(measured_points) +
-                         other.mean_deviation_mm * double(other.measured_points)) / double(measured);
+    mean_deviation_mm =
+        (mean_deviation_mm * double(measured_points) + other.mean_deviation_mm * double(other.measured_points)) /
+        double(measured);
   measured_points = measured;
   input_points += other.input_points;
   output_points += other.output_points;

@@ -77,7 +77,6 @@ struct EncodeReport {
   void merge(const EncodeReport& other);
 };
 
-
 class FibletEncoder {
  public:
   // Throws Error when the parameters are invalid.
@@ -112,8 +111,8 @@ class FibletEncoder {
     // The fiblet in progress: points [first, first + count), the next point
     // k, at most count_max points; its record at bytes[base].
     size_t first = 0, k = 0, count = 0, count_max = 0, base = 0;
-    Frame4 w;                               // the decoder's frame after point k - 1
-    shader::FibletTransform truth{};        // TrueFrame mode only
+    Frame4 w;                         // the decoder's frame after point k - 1
+    shader::FibletTransform truth{};  // TrueFrame mode only
     bool active = false;
   };
   struct Placement {
@@ -163,9 +162,9 @@ class FibletEncoder {
   CodecErrorMeter* meter_ = nullptr;
   double um2_per_unit2_;  // (world micrometres per normalised unit)^2
   shader::vec3 v_;
-  double len2_lo_, len2_hi_;     // accepted squared step lengths (step_tolerance)
+  double len2_lo_, len2_hi_;  // accepted squared step lengths (step_tolerance)
   double cos_alpha_, cos2_alpha_;
-  double max_error2_;            // closed loop: squared max_point_error
+  double max_error2_;  // closed loop: squared max_point_error
   // Measured single-threaded on the phantom: 1 lane 20.5 M points/s, 2 lanes
   // 30, 3 and 4 lanes 30 (the out-of-order window holds about two steps).
   static constexpr size_t kLanes = 2;

@@ -34,9 +34,7 @@ inline shader::FibletTransform toTransform(const Frame4& f) {
 }
 
 // Rotation part of a times v: (c0 v.x + c1 v.y) + c2 v.z, as fibletRotate.
-inline V4f rotate4(const Frame4& a, V4f v) {
-  return (a.c0 * splat4(v[0]) + a.c1 * splat4(v[1])) + a.c2 * splat4(v[2]);
-}
+inline V4f rotate4(const Frame4& a, V4f v) { return (a.c0 * splat4(v[0]) + a.c1 * splat4(v[1])) + a.c2 * splat4(v[2]); }
 
 // a * b, as fibletCompose.
 inline Frame4 compose4(const Frame4& a, const Frame4& b) {

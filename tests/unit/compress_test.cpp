@@ -7,9 +7,9 @@
 
 #include <algorithm>
 #include <atomic>
-#include <map>
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <random>
@@ -140,8 +140,8 @@ TEST(CompressCli, reportNamesEveryFigureTheIssueAsksFor) {
   const std::string tck = writePhantom(dir, 0.1, 50);
   const auto r = runFibscope("compress " + tck + " " + dir.file("p.fbl") + " --report");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  for (const char* what : {"bytes/point", "ratio", "error", "max", "mean", "p99", "turns above alpha",
-                           "one-point", "two-point", "points/s", "percentile", "largest turn"})
+  for (const char* what : {"bytes/point", "ratio", "error", "max", "mean", "p99", "turns above alpha", "one-point",
+                           "two-point", "points/s", "percentile", "largest turn"})
     EXPECT_NE(r.output.find(what), std::string::npos) << what << " missing from:\n" << r.output;
   const auto again = runFibscope("compress " + tck + " " + dir.file("p.fbl"));
   EXPECT_EQ(again.exit_code, 2);
@@ -265,7 +265,8 @@ TEST(Compressor, variableStepsAreSplitOrResampledAndCounted) {
   for (size_t s = 0; s < full.streamlineCount(); ++s) {
     std::vector<float> xyz;
     for (size_t i = 0; i < full.pointsIn(s); ++i)
-      if (i % 7 != 3 || i + 1 == full.pointsIn(s)) xyz.insert(xyz.end(), full.point(full.offsets[s] + i), full.point(full.offsets[s] + i) + 3);
+      if (i % 7 != 3 || i + 1 == full.pointsIn(s))
+        xyz.insert(xyz.end(), full.point(full.offsets[s] + i), full.point(full.offsets[s] + i) + 3);
     t.addStreamline(xyz.data(), xyz.size() / 3);
   }
   TractogramHeader header;
@@ -317,9 +318,8 @@ TEST(Compressor, failureDuringEncodingLeavesNothingBehind) {
   int opened = 0;
   CompressOptions options = quietOptions();
   options.chunk_points = 2000;
-  EXPECT_THROW(compressTractogram(
-                   [&] { return std::make_unique<FailingReader>(phantomReader(60), ++opened == 2); },
-                   dir.file("x.fbl"), options),
+  EXPECT_THROW(compressTractogram([&] { return std::make_unique<FailingReader>(phantomReader(60), ++opened == 2); },
+                                  dir.file("x.fbl"), options),
                Error);
   EXPECT_EQ(opened, 2);
   EXPECT_TRUE(std::filesystem::is_empty(dir.path())) << "left files in " << dir.path();
@@ -361,7 +361,8 @@ TEST(FastDirectionQuantizer, blockHoldsTheExactCellAndMatchesTheExactBlockAwayFr
     EXPECT_EQ(fast.block2(d[0], d[1], d[2]), blockOrigin(encodeDirectionGrid(d.data(), 10 * kDeg), 2));
   }
   // Blocks stay inside the grid and hold the cell at every corner.
-  for (const DirectionGrid g : {DirectionGrid{0, 0}, DirectionGrid{16, 16}, DirectionGrid{0.2, 15.9}, DirectionGrid{7.5, 8.49}}) {
+  for (const DirectionGrid g :
+       {DirectionGrid{0, 0}, DirectionGrid{16, 16}, DirectionGrid{0.2, 15.9}, DirectionGrid{7.5, 8.49}}) {
     for (int size : {1, 2, 3, 5}) {
       const uint32_t o = blockOrigin(g, size);
       EXPECT_LE(int(o >> 4) + size, 16);
@@ -379,7 +380,8 @@ TEST(Compressor, blockSizesTwoAndThreeGiveTheSameErrorsAndOneIsWorse) {
   for (int size : {1, 2, 3}) {
     CompressOptions options = quietOptions();
     options.encode.search_size = size;
-    by_size[size] = compressTractogram([] { return phantomReader(100); }, dir.file(std::to_string(size) + ".fbl"), options);
+    by_size[size] =
+        compressTractogram([] { return phantomReader(100); }, dir.file(std::to_string(size) + ".fbl"), options);
   }
   std::cout << "[search] max error 1x1 " << by_size[1].error.max_um << " um, 2x2 " << by_size[2].error.max_um
             << " um, 3x3 " << by_size[3].error.max_um << " um; mean " << by_size[1].error.mean_um << " / "

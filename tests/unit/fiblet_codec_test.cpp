@@ -213,13 +213,12 @@ void checkErrorTargets(double step, double max_um, double mean_um) {
   const Coded open = encodeAndMeasure(t, params, EncodeMode::OpenLoop);
   const Coded naive = encodeAndMeasure(t, params, EncodeMode::TrueFrame);
   const double bytes = double(closed.fiblets.bytes.size() + closed.fiblets.tableBytes()) / double(t.pointCount());
-  std::cout << "[fiblet " << step << " mm] points " << t.pointCount() << ", alpha "
-            << params.alpha / kDeg << " deg; closed loop max " << closed.error.max_um << " um, mean "
-            << closed.error.mean_um << " um, p99 " << closed.error.p99_um << " um, splits "
-            << closed.report.splits() << " (angle " << closed.report.angle_splits << ", error "
-            << closed.report.error_splits << "); open loop max " << open.error.max_um << " um, mean "
-            << open.error.mean_um << " um; true-frame open loop max " << naive.error.max_um << " um, mean "
-            << naive.error.mean_um << " um; " << bytes << " bytes/point\n";
+  std::cout << "[fiblet " << step << " mm] points " << t.pointCount() << ", alpha " << params.alpha / kDeg
+            << " deg; closed loop max " << closed.error.max_um << " um, mean " << closed.error.mean_um << " um, p99 "
+            << closed.error.p99_um << " um, splits " << closed.report.splits() << " (angle "
+            << closed.report.angle_splits << ", error " << closed.report.error_splits << "); open loop max "
+            << open.error.max_um << " um, mean " << open.error.mean_um << " um; true-frame open loop max "
+            << naive.error.max_um << " um, mean " << naive.error.mean_um << " um; " << bytes << " bytes/point\n";
   EXPECT_LE(closed.error.max_um, max_um);
   EXPECT_LE(closed.error.mean_um, mean_um);
   EXPECT_LE(closed.error.max_um, 0.5 * open.error.max_um);

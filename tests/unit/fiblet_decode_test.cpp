@@ -79,8 +79,12 @@ TEST(FibletDecode, handBuiltRecordsMatchTheDoublePrecisionReference) {
   for (int trial = 0; trial < 200; ++trial) {
     std::vector<uint8_t> record(p.recordBytes(), 0);
     const uint32_t count = 1 + random() % 60;
-    const uint16_t q[6] = {uint16_t(20000 + random() % 20000), uint16_t(20000 + random() % 20000),
-                           uint16_t(20000 + random() % 20000), 0, 0, 0};
+    const uint16_t q[6] = {uint16_t(20000 + random() % 20000),
+                           uint16_t(20000 + random() % 20000),
+                           uint16_t(20000 + random() % 20000),
+                           0,
+                           0,
+                           0};
     uint16_t q1[3];
     for (int c = 0; c < 3; ++c) q1[c] = uint16_t(q[c] + int(random() % 131) - 65);
     for (int c = 0; c < 3; ++c) {
@@ -131,7 +135,8 @@ void scalarDecode(const FibletDecoder& d, const uint8_t* record, bool scan, std:
   const auto point = [&](int which) {
     float c[3];
     for (int axis = 0; axis < 3; ++axis)
-      c[axis] = shader::fibletDequantize(uint32_t(record[6 * which + 2 * axis]) | uint32_t(record[6 * which + 2 * axis + 1]) << 8);
+      c[axis] = shader::fibletDequantize(uint32_t(record[6 * which + 2 * axis]) |
+                                         uint32_t(record[6 * which + 2 * axis + 1]) << 8);
     return shader::vec3(c[0], c[1], c[2]);
   };
   const shader::vec3 v(d.params().v[0], d.params().v[1], d.params().v[2]);
@@ -145,7 +150,8 @@ void scalarDecode(const FibletDecoder& d, const uint8_t* record, bool scan, std:
   if (scan) {
     for (uint32_t offset = 1; offset < lane.size(); offset *= 2) {
       const auto previous = lane;
-      for (uint32_t i = offset; i < lane.size(); ++i) lane[i] = shader::fibletCompose(previous[i - offset], previous[i]);
+      for (uint32_t i = offset; i < lane.size(); ++i)
+        lane[i] = shader::fibletCompose(previous[i - offset], previous[i]);
     }
   } else {
     for (uint32_t i = 1; i < lane.size(); ++i) lane[i] = shader::fibletCompose(lane[i - 1], lane[i]);
@@ -171,7 +177,8 @@ TEST(FibletDecode, vectorisedDecodersAreBitIdenticalToTheSharedScalarArithmetic)
     for (size_t i = 0; i < f.fibletCount(); ++i) {
       for (const bool scan : {false, true}) {
         scalarDecode(decoder, f.record(i), scan, want);
-        const uint32_t count = scan ? decoder.decodeScan(f.record(i), got.data()) : decoder.decodeSequential(f.record(i), got.data());
+        const uint32_t count =
+            scan ? decoder.decodeScan(f.record(i), got.data()) : decoder.decodeSequential(f.record(i), got.data());
         ASSERT_EQ(size_t(count) * 3, want.size());
         ASSERT_EQ(std::memcmp(got.data(), want.data(), want.size() * sizeof(float)), 0)
             << "fiblet " << i << (scan ? " scan" : " sequential") << " N " << n;
@@ -246,8 +253,9 @@ void main() {
 }
 )";
   const std::string shaders = std::string(FIBSCOPE_TEST_TOOLS_DIR) + "/../../shaders";
-  const test::CommandResult r = test::runCommand("glslangValidator -V --target-env vulkan1.3 -I'" + shaders + "' '" +
-                                                 dir.file("decode.comp") + "' -o '" + dir.file("decode.spv") + "' 2>&1");
+  const test::CommandResult r =
+      test::runCommand("glslangValidator -V --target-env vulkan1.3 -I'" + shaders + "' '" + dir.file("decode.comp") +
+                       "' -o '" + dir.file("decode.spv") + "' 2>&1");
   EXPECT_EQ(r.exit_code, 0) << r.output;
 }
 
