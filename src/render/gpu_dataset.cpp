@@ -1,0 +1,340 @@
+#include "render/gpu_dataset.h"
+
+#include <algorithm>
+#include <cstring>
+#include <limits>
+#include <utility>
+#include <vector>
+
+#include "codec/fbl_codec.h"
+#include "core/error.h"
+#include "gpu/submit.h"
+#include "gpu/vk_check.h"
+
+namespace fibscope {
+
+namespace {
+
+// The staging buffer's size: large enough that the per-copy submission is
+// noise (a few ms per 64 MiB even on lavapipe), small enough to find in any
+// host-visible heap.
+constexpr uint64_t kStagingBytes = uint64_t(64) << 20;
+
+// Shaders index fiblets and fibers with uint.
+constexpr uint64_t kMaxCount = uint64_t(std::numeric_limits<uint32_t>::max());
+
+// createBuffer refuses 0 bytes; an empty table still gets a valid address.
+VkDeviceSize bufferSize(uint64_t bytes) { return std::max<uint64_t>(bytes, 4); }
+
+// The per-fiber tables the shaders need, derived from the first fiblet of
+// each fiber (fibers + 1 entries, the last one the fiblet count).
+struct FiberTables {
+  std::vector<uint32_t> first;         // fibers + 1
+  std::vector<uint32_t> fiblet_fiber;  // fiblets
+};
+
+// `first` holds `fibers` + 1 entries. Fails naming `name` unless they run
+// from 0 to `fiblets` without decreasing (a fiber of no fiblets is allowed:
+// it owns an empty range).
+template <typename T>
+FiberTables deriveFiberTables(const std::string& name, std::span<const T> first, uint64_t fiblets) {
+  const size_t fibers = first.size() - 1;
+  if (uint64_t(first[0]) != 0)
+    fail(name, "fiber_first_fiblet[0] is " + std::to_string(uint64_t(first[0])) + ", expected 0");
+  if (uint64_t(first[fibers]) != fiblets)
+    fail(name, "fiber_first_fiblet ends at " + std::to_string(uint64_t(first[fibers])) + ", expected the fiblet count " +
+                   std::to_string(fiblets));
+  FiberTables tables;
+  tables.first.resize(fibers + 1);
+  tables.fiblet_fiber.resize(fiblets);
+  for (size_t f = 0; f < fibers; ++f) {
+    const uint64_t begin = first[f], end = first[f + 1];
+    if (end < begin)
+      fail(name, "fiber_first_fiblet decreases at fiber " + std::to_string(f + 1) + " (" + std::to_string(begin) +
+                     " then " + std::to_string(end) + ")");
+    tables.first[f] = uint32_t(begin);
+    std::fill(tables.fiblet_fiber.begin() + ptrdiff_t(begin), tables.fiblet_fiber.begin() + ptrdiff_t(end),
+              uint32_t(f));
+  }
+  tables.first[fibers] = uint32_t(fiblets);
+  return tables;
+}
+
+// Copies `bytes` of `data` to the start of `destination` through
+// `staging`, one staging-full at a time, each copy submitted and waited for.
+void uploadChunked(const gpu::VulkanContext& context, const gpu::Buffer& staging, const gpu::Buffer& destination,
+                   const void* data, uint64_t bytes, Progress* progress) {
+  const auto* source = static_cast<const uint8_t*>(data);
+  for (uint64_t offset = 0; offset < bytes;) {
+    const uint64_t chunk = std::min<uint64_t>(staging.size, bytes - offset);
+    std::memcpy(staging.mapped, source + offset, size_t(chunk));
+    if (!staging.coherent) {
+      VkMappedMemoryRange range{VK_STRUCTURE_TYPE_MAPPED_MEMORY_RANGE};
+      range.memory = staging.memory;
+      range.size = VK_WHOLE_SIZE;
+      VK_CHECK(vkFlushMappedMemoryRanges(context.device(), 1, &range));
+    }
+    gpu::submitOnce(context, [&](VkCommandBuffer cmd) {
+      const VkBufferCopy copy{0, offset, chunk};
+      vkCmdCopyBuffer(cmd, staging.buffer, destination.buffer, 1, &copy);
+      // The fence orders the host only: make the copy visible to every
+      // later command on the queue (the passes that read the dataset).
+      gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                         VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                         VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT);
+    });
+    offset += chunk;
+    if (progress) progress->add(double(chunk));
+  }
+}
+
+}  // namespace
+
+DeviceLimits deviceLimits(const gpu::VulkanContext& context) {
+  DeviceLimits limits;
+  limits.device_name = context.info().name;
+  const VkPhysicalDeviceMemoryProperties& memory = context.memoryProperties();
+  uint64_t largest_heap = 0;
+  for (uint32_t h = 0; h < memory.memoryHeapCount; ++h) {
+    largest_heap = std::max<uint64_t>(largest_heap, memory.memoryHeaps[h].size);
+    if (memory.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT)
+      limits.device_local_heap_bytes = std::max<uint64_t>(limits.device_local_heap_bytes, memory.memoryHeaps[h].size);
+  }
+  // Vulkan requires a device-local heap; should a driver not flag one, the
+  // largest heap is the best estimate of what the buffers can use.
+  if (limits.device_local_heap_bytes == 0) limits.device_local_heap_bytes = largest_heap;
+
+  VkPhysicalDeviceVulkan13Properties vulkan13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_PROPERTIES};
+  VkPhysicalDeviceVulkan11Properties vulkan11{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_PROPERTIES};
+  vulkan11.pNext = &vulkan13;
+  VkPhysicalDeviceProperties2 properties{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+  properties.pNext = &vulkan11;
+  vkGetPhysicalDeviceProperties2(context.physicalDevice(), &properties);
+  limits.max_allocation_bytes = vulkan11.maxMemoryAllocationSize;
+  limits.max_buffer_bytes = vulkan13.maxBufferSize;
+  return limits;
+}
+
+uint64_t DatasetBytes::largest() const {
+  return std::max({records, fiblet_fiber, directions, fiber_first_fiblet, fiber_length, block});
+}
+
+DatasetBytes datasetBytes(uint64_t fibers, uint64_t fiblets, uint32_t record_bytes) {
+  DatasetBytes bytes;
+  bytes.records = fiblets * record_bytes;
+  bytes.fiblet_fiber = fiblets * sizeof(uint32_t);
+  bytes.directions = shader::kFibletCodeCount * sizeof(shader::vec4);
+  bytes.fiber_first_fiblet = (fibers + 1) * sizeof(uint32_t);
+  bytes.fiber_length = fibers * sizeof(float);
+  bytes.block = sizeof(shader::FibletDataset);
+  return bytes;
+}
+
+void checkDatasetFits(const std::string& name, uint64_t fibers, uint64_t fiblets, const DatasetBytes& bytes,
+                      const DeviceLimits& limits) {
+  // 2^32 - 1 itself is refused too: fiber_first_fiblet's last entry is the
+  // fiblet count, and the fiber index must leave room for fibers + 1.
+  if (fiblets >= kMaxCount || fibers >= kMaxCount)
+    fail(name, std::to_string(fiblets) + " fiblets of " + std::to_string(fibers) +
+                   " fibers: the GPU renderer indexes fiblets and fibers with 32 bits (at most " +
+                   std::to_string(kMaxCount - 1) + " each); streaming is not implemented yet");
+  const uint64_t per_buffer = std::min(limits.max_allocation_bytes, limits.max_buffer_bytes);
+  const uint64_t total = bytes.total();
+  if (total <= limits.device_local_heap_bytes && bytes.largest() <= per_buffer) return;
+  // Name the single buffer when it, not the total, is what does not fit.
+  const std::string buffer_note =
+      total <= limits.device_local_heap_bytes
+          ? "the fiblet records need one buffer of " + formatBytes(double(bytes.largest())) + "; "
+          : std::string();
+  const std::string what = formatBytes(double(total)) + " of fiblets and tables do not fit on " +
+                           limits.device_name + " (" + buffer_note + "largest allocation " +
+                           formatBytes(double(limits.max_allocation_bytes)) + ", largest buffer " +
+                           formatBytes(double(limits.max_buffer_bytes)) + ", device-local heap " +
+                           formatBytes(double(limits.device_local_heap_bytes)) +
+                           "); streaming is not implemented yet";
+  fail(name, what);
+}
+
+GpuDataset::~GpuDataset() { release(); }
+
+GpuDataset::GpuDataset(GpuDataset&& other) noexcept
+    : context_(std::exchange(other.context_, nullptr)),
+      records_(std::exchange(other.records_, {})),
+      fiblet_fiber_(std::exchange(other.fiblet_fiber_, {})),
+      directions_(std::exchange(other.directions_, {})),
+      fiber_first_fiblet_(std::exchange(other.fiber_first_fiblet_, {})),
+      fiber_length_(std::exchange(other.fiber_length_, {})),
+      block_buffer_(std::exchange(other.block_buffer_, {})),
+      block_(std::exchange(other.block_, {})) {}
+
+GpuDataset& GpuDataset::operator=(GpuDataset&& other) noexcept {
+  if (this != &other) {
+    release();
+    context_ = std::exchange(other.context_, nullptr);
+    records_ = std::exchange(other.records_, {});
+    fiblet_fiber_ = std::exchange(other.fiblet_fiber_, {});
+    directions_ = std::exchange(other.directions_, {});
+    fiber_first_fiblet_ = std::exchange(other.fiber_first_fiblet_, {});
+    fiber_length_ = std::exchange(other.fiber_length_, {});
+    block_buffer_ = std::exchange(other.block_buffer_, {});
+    block_ = std::exchange(other.block_, {});
+  }
+  return *this;
+}
+
+void GpuDataset::release() {
+  if (!context_) return;
+  for (gpu::Buffer* b : {&records_, &fiblet_fiber_, &directions_, &fiber_first_fiblet_, &fiber_length_, &block_buffer_})
+    gpu::destroyBuffer(*context_, *b);
+  context_ = nullptr;
+  block_ = {};
+}
+
+uint64_t GpuDataset::bytes() const {
+  return records_.size + fiblet_fiber_.size + directions_.size + fiber_first_fiblet_.size + fiber_length_.size +
+         block_buffer_.size;
+}
+
+// What both upload paths hand to the common part, after the size check.
+struct GpuDataset::Source {
+  std::span<const uint8_t> records;
+  FiberTables tables;
+  std::span<const float> fiber_length_mm;
+  CodecParams params;
+};
+
+// Allocates every buffer, then copies; on an exception the caller's
+// partly built dataset frees what was allocated.
+void GpuDataset::fill(const gpu::VulkanContext& context, const Source& source, const DatasetBytes& bytes,
+                      Progress* progress) {
+  context_ = &context;
+  gpu::Buffer& records = records_;
+  gpu::Buffer& fiblet_fiber = fiblet_fiber_;
+  gpu::Buffer& directions = directions_;
+  gpu::Buffer& first = fiber_first_fiblet_;
+  gpu::Buffer& length = fiber_length_;
+  gpu::Buffer& block_buffer = block_buffer_;
+  shader::FibletDataset& block = block_;
+  records = gpu::createBuffer(context, bufferSize(bytes.records), gpu::MemoryUse::DeviceLocal);
+  fiblet_fiber = gpu::createBuffer(context, bufferSize(bytes.fiblet_fiber), gpu::MemoryUse::DeviceLocal);
+  directions = gpu::createBuffer(context, bufferSize(bytes.directions), gpu::MemoryUse::DeviceLocal);
+  first = gpu::createBuffer(context, bufferSize(bytes.fiber_first_fiblet), gpu::MemoryUse::DeviceLocal);
+  length = gpu::createBuffer(context, bufferSize(bytes.fiber_length), gpu::MemoryUse::DeviceLocal);
+  block_buffer = gpu::createBuffer(context, bufferSize(bytes.block), gpu::MemoryUse::DeviceLocal);
+
+  const CodecParams& params = source.params;
+  block.records = records.address;
+  block.fiblet_fiber = fiblet_fiber.address;
+  block.directions = directions.address;
+  block.fiber_first_fiblet = first.address;
+  block.fiber_length_mm = length.address;
+  block.fiber_count = uint32_t(source.tables.first.size() - 1);
+  block.fiblet_count = uint32_t(source.tables.fiblet_fiber.size());
+  block.record_words = params.recordBytes() / 4;
+  block.points_per_fiblet = params.points_per_fiblet;
+  block.translation_x = params.translation[0];
+  block.translation_y = params.translation[1];
+  block.translation_z = params.translation[2];
+  block.mm_per_unit = float(1.0 / double(params.scale));
+  block.delta = params.delta;
+  block.v_x = params.v[0];
+  block.v_y = params.v[1];
+  block.v_z = params.v[2];
+  const FibletDirectionTable table = buildDirectionTable(params.alpha);
+
+  if (progress) progress->setTotal(double(bytes.total()));
+  gpu::Buffer staging =
+      gpu::createBuffer(context, std::min<uint64_t>(kStagingBytes, std::max<uint64_t>(bytes.largest(), 4)),
+                        gpu::MemoryUse::Upload);
+  try {
+    uploadChunked(context, staging, records, source.records.data(), bytes.records, progress);
+    uploadChunked(context, staging, fiblet_fiber, source.tables.fiblet_fiber.data(), bytes.fiblet_fiber, progress);
+    uploadChunked(context, staging, directions, table.data(), bytes.directions, progress);
+    uploadChunked(context, staging, first, source.tables.first.data(), bytes.fiber_first_fiblet, progress);
+    uploadChunked(context, staging, length, source.fiber_length_mm.data(), bytes.fiber_length, progress);
+    uploadChunked(context, staging, block_buffer, &block, bytes.block, progress);
+  } catch (...) {
+    gpu::destroyBuffer(context, staging);
+    throw;
+  }
+  gpu::destroyBuffer(context, staging);
+}
+
+GpuDataset GpuDataset::upload(const gpu::VulkanContext& context, const FblFile& file, Progress* progress,
+                              const DeviceLimits* limits) {
+  const std::string& name = file.path();
+  Source source;
+  source.params = codecParamsFromFbl(file.header(), name);
+  const uint32_t record_bytes = source.params.recordBytes();
+
+  // Sizes from the section table only: nothing is read or allocated before
+  // the size check.
+  const auto section = [&](std::string_view section_name, FblDType dtype) -> const FblSection& {
+    const FblSection* s = file.find(section_name);
+    if (!s) fail(name, "no \"" + std::string(section_name) + "\" section");
+    if (s->dtype != dtype || s->components != 1)
+      fail(name, "section \"" + std::string(section_name) + "\" is " + fblDTypeName(s->dtype) + " x " +
+                     std::to_string(s->components) + ", expected " + fblDTypeName(dtype) + " x 1");
+    return *s;
+  };
+  const FblSection& fiblet_section = section(kFblSectionFiblets, FblDType::kUint32);
+  const FblSection& first_section = section(kFblSectionFiberFirstFiblet, FblDType::kUint64);
+  const FblSection& length_section = section(kFblSectionFiberLength, FblDType::kFloat32);
+  if (fiblet_section.bytes % record_bytes != 0)
+    fail(name, "section \"fiblets\" has " + std::to_string(fiblet_section.bytes) +
+                   " bytes, not a whole number of " + std::to_string(record_bytes) + "-byte records");
+  const uint64_t fiblets = fiblet_section.bytes / record_bytes;
+  if (first_section.element_count == 0) fail(name, "section \"fiber_first_fiblet\" is empty, expected fibers + 1");
+  const uint64_t fibers = first_section.element_count - 1;
+  if (fiblets != file.header().fiblet_count || fibers != file.header().fiber_count)
+    fail(name, "the sections hold " + std::to_string(fiblets) + " fiblets of " + std::to_string(fibers) +
+                   " fibers, the header says " + std::to_string(file.header().fiblet_count) + " of " +
+                   std::to_string(file.header().fiber_count));
+  if (length_section.element_count != fibers)
+    fail(name, "section \"fiber_length_mm\" has " + std::to_string(length_section.element_count) +
+                   " values, expected one per fiber (" + std::to_string(fibers) + ")");
+  const DatasetBytes bytes = datasetBytes(fibers, fiblets, record_bytes);
+  checkDatasetFits(name, fibers, fiblets, bytes, limits ? *limits : deviceLimits(context));
+
+  source.tables = deriveFiberTables(name, file.array<uint64_t>(first_section), fiblets);
+  source.fiber_length_mm = file.array<float>(length_section);
+  source.records = file.data(fiblet_section);
+
+  GpuDataset dataset;
+  dataset.fill(context, source, bytes, progress);
+  return dataset;
+}
+
+GpuDataset GpuDataset::upload(const gpu::VulkanContext& context, const EncodedFiblets& fiblets,
+                              const CodecParams& params, std::span<const float> fiber_length_mm,
+                              const std::string& name, Progress* progress, const DeviceLimits* limits) {
+  validateCodecParams(params);
+  if (fiblets.fiblet_base != 0)
+    fail(name, "the fiblets start at global index " + std::to_string(fiblets.fiblet_base) +
+                   ": only whole tractograms can be uploaded");
+  const uint32_t record_bytes = params.recordBytes();
+  if (fiblets.record_bytes != record_bytes || fiblets.bytes.size() % record_bytes != 0)
+    fail(name, std::to_string(fiblets.bytes.size()) + " bytes of " + std::to_string(fiblets.record_bytes) +
+                   "-byte records, expected whole " + std::to_string(record_bytes) + "-byte records for N = " +
+                   std::to_string(params.points_per_fiblet));
+  const uint64_t count = fiblets.fibletCount();
+  const uint64_t fibers = fiblets.fiber_first_fiblet.size();
+  if (fiber_length_mm.size() != fibers)
+    fail(name, std::to_string(fiber_length_mm.size()) + " fiber lengths for " + std::to_string(fibers) + " fibers");
+  const DatasetBytes bytes = datasetBytes(fibers, count, record_bytes);
+  checkDatasetFits(name, fibers, count, bytes, limits ? *limits : deviceLimits(context));
+
+  Source source;
+  source.params = params;
+  std::vector<uint32_t> first(fiblets.fiber_first_fiblet);
+  first.push_back(uint32_t(count));  // < 2^32: checked above
+  source.tables = deriveFiberTables(name, std::span<const uint32_t>(first), count);
+  source.fiber_length_mm = fiber_length_mm;
+  source.records = fiblets.bytes;
+
+  GpuDataset dataset;
+  dataset.fill(context, source, bytes, progress);
+  return dataset;
+}
+
+}  // namespace fibscope
