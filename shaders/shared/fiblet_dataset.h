@@ -8,9 +8,9 @@
 // buffer reference it costs one uniform, cached load per workgroup.
 //
 // Buffers are device addresses (uint64_t; the shader casts them to buffer
-// references). Counts are uint32: the uploader refuses datasets of 2^32
-// fiblets or more, which also bounds the fiber count (a fiber has at least
-// one fiblet).
+// references). Counts are uint32: the uploader refuses datasets of 2^32 - 1
+// fiblets or fibers or more (fiber_first_fiblet's last entry is the fiblet
+// count).
 #ifndef FIBSCOPE_SHADERS_SHARED_FIBLET_DATASET_H
 #define FIBSCOPE_SHADERS_SHARED_FIBLET_DATASET_H
 

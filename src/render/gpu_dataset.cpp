@@ -15,11 +15,6 @@ namespace fibscope {
 
 namespace {
 
-// The staging buffer's size: large enough that the per-copy submission is
-// noise (a few ms per 64 MiB even on lavapipe), small enough to find in any
-// host-visible heap.
-constexpr uint64_t kStagingBytes = uint64_t(64) << 20;
-
 // Shaders index fiblets and fibers with uint.
 constexpr uint64_t kMaxCount = uint64_t(std::numeric_limits<uint32_t>::max());
 
@@ -206,7 +201,7 @@ struct GpuDataset::Source {
 // Allocates every buffer, then copies; on an exception the caller's
 // partly built dataset frees what was allocated.
 void GpuDataset::fill(const gpu::VulkanContext& context, const Source& source, const DatasetBytes& bytes,
-                      Progress* progress) {
+                      Progress* progress, uint64_t staging_bytes) {
   context_ = &context;
   gpu::Buffer& records = records_;
   gpu::Buffer& fiblet_fiber = fiblet_fiber_;
@@ -244,7 +239,7 @@ void GpuDataset::fill(const gpu::VulkanContext& context, const Source& source, c
 
   if (progress) progress->setTotal(double(bytes.total()));
   gpu::Buffer staging =
-      gpu::createBuffer(context, std::min<uint64_t>(kStagingBytes, std::max<uint64_t>(bytes.largest(), 4)),
+      gpu::createBuffer(context, std::clamp<uint64_t>(bytes.largest(), 4, std::max<uint64_t>(staging_bytes, 4)),
                         gpu::MemoryUse::Upload);
   try {
     uploadChunked(context, staging, records, source.records.data(), bytes.records, progress);
@@ -261,7 +256,7 @@ void GpuDataset::fill(const gpu::VulkanContext& context, const Source& source, c
 }
 
 GpuDataset GpuDataset::upload(const gpu::VulkanContext& context, const FblFile& file, Progress* progress,
-                              const DeviceLimits* limits) {
+                              const DeviceLimits* limits, uint64_t staging_bytes) {
   const std::string& name = file.path();
   Source source;
   source.params = codecParamsFromFbl(file.header(), name);
@@ -301,13 +296,14 @@ GpuDataset GpuDataset::upload(const gpu::VulkanContext& context, const FblFile& 
   source.records = file.data(fiblet_section);
 
   GpuDataset dataset;
-  dataset.fill(context, source, bytes, progress);
+  dataset.fill(context, source, bytes, progress, staging_bytes);
   return dataset;
 }
 
 GpuDataset GpuDataset::upload(const gpu::VulkanContext& context, const EncodedFiblets& fiblets,
                               const CodecParams& params, std::span<const float> fiber_length_mm,
-                              const std::string& name, Progress* progress, const DeviceLimits* limits) {
+                              const std::string& name, Progress* progress, const DeviceLimits* limits,
+                              uint64_t staging_bytes) {
   validateCodecParams(params);
   if (fiblets.fiblet_base != 0)
     fail(name, "the fiblets start at global index " + std::to_string(fiblets.fiblet_base) +
@@ -333,7 +329,7 @@ GpuDataset GpuDataset::upload(const gpu::VulkanContext& context, const EncodedFi
   source.records = fiblets.bytes;
 
   GpuDataset dataset;
-  dataset.fill(context, source, bytes, progress);
+  dataset.fill(context, source, bytes, progress, staging_bytes);
   return dataset;
 }
 

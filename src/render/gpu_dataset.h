@@ -27,6 +27,11 @@
 
 namespace fibscope {
 
+// The staging buffer's default size: large enough that the per-copy
+// submission is noise (a few ms per 64 MiB even on lavapipe), small enough
+// to find in any host-visible heap.
+inline constexpr uint64_t kDatasetStagingBytes = uint64_t(64) << 20;
+
 // What bounds a dataset on a device.
 struct DeviceLimits {
   std::string device_name;
@@ -75,16 +80,17 @@ class GpuDataset {
   // the device's own, for tests), when a section is missing, of the wrong
   // type or size, or fails its checksum, or when fiber_first_fiblet is not
   // increasing from 0 to the fiblet count. `progress` (optional) counts the
-  // bytes uploaded.
+  // bytes uploaded; sections are copied `staging_bytes` at a time.
   static GpuDataset upload(const gpu::VulkanContext& context, const FblFile& file, Progress* progress = nullptr,
-                           const DeviceLimits* limits = nullptr);
+                           const DeviceLimits* limits = nullptr, uint64_t staging_bytes = kDatasetStagingBytes);
 
   // Uploads a tractogram encoded in memory (a whole one: fiblet_base 0),
   // with its fibers' lengths in mm (one per fiber). `name` stands for the
   // file in messages.
   static GpuDataset upload(const gpu::VulkanContext& context, const EncodedFiblets& fiblets, const CodecParams& params,
                            std::span<const float> fiber_length_mm, const std::string& name,
-                           Progress* progress = nullptr, const DeviceLimits* limits = nullptr);
+                           Progress* progress = nullptr, const DeviceLimits* limits = nullptr,
+                           uint64_t staging_bytes = kDatasetStagingBytes);
 
   // The block as uploaded (addresses of this dataset's buffers).
   const shader::FibletDataset& block() const { return block_; }
@@ -103,7 +109,8 @@ class GpuDataset {
 
  private:
   struct Source;
-  void fill(const gpu::VulkanContext& context, const Source& source, const DatasetBytes& bytes, Progress* progress);
+  void fill(const gpu::VulkanContext& context, const Source& source, const DatasetBytes& bytes, Progress* progress,
+            uint64_t staging_bytes);
   void release();
 
   const gpu::VulkanContext* context_ = nullptr;

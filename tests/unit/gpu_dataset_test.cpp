@@ -182,6 +182,16 @@ TEST_F(GpuDatasetUpload, uploadedBuffersEqualTheFileSectionsAndDerivedTables) {
               context().info().name.c_str());
 }
 
+TEST_F(GpuDatasetUpload, smallStagingBufferCopiesInManyChunksToTheSameBytes) {
+  const FblFile file = FblFile::open(compressPhantom(dir_, 60));
+  // 1000 bytes: chunk boundaries fall inside records and inside words.
+  Progress progress("uploading", 0, "bytes", false);
+  const GpuDataset dataset = GpuDataset::upload(context(), file, &progress, nullptr, 1000);
+  ASSERT_GT(dataset.records().size, 100u * 1000u);
+  expectMatchesFile(dataset, file);
+  EXPECT_EQ(progress.snapshot().done, double(dataset.bytes()));
+}
+
 TEST_F(GpuDatasetUpload, passReadingOnlyTheBlockDecodesBitForBitLikeTheCpuScan) {
   for (uint32_t n : {60u, 8u}) {
     SCOPED_TRACE("N = " + std::to_string(n));
@@ -243,6 +253,7 @@ TEST_F(GpuDatasetUpload, datasetTooBigForTheDeviceFailsWithOneLineBeforeReadingA
     EXPECT_NE(what.find("device-local heap 16.00 KiB"), std::string::npos) << what;
     EXPECT_NE(what.find("streaming is not implemented yet"), std::string::npos) << what;
     EXPECT_EQ(what.find("one buffer"), std::string::npos) << what;
+    std::printf("[ GPU      ] %s\n", what.c_str());
   }
 
   // The heap is large enough, one buffer is not.
