@@ -47,6 +47,10 @@ FiberTables deriveFiberTables(const std::string& name, std::span<const T> first,
     if (end < begin)
       fail(name, "fiber_first_fiblet decreases at fiber " + std::to_string(f + 1) + " (" + std::to_string(begin) +
                      " then " + std::to_string(end) + ")");
+    // Checked before the fill: a later decrease would come too late.
+    if (end > fiblets)
+      fail(name, "fiber_first_fiblet[" + std::to_string(f + 1) + "] is " + std::to_string(end) +
+                     ", beyond the fiblet count " + std::to_string(fiblets));
     tables.first[f] = uint32_t(begin);
     std::fill(tables.fiblet_fiber.begin() + ptrdiff_t(begin), tables.fiblet_fiber.begin() + ptrdiff_t(end),
               uint32_t(f));

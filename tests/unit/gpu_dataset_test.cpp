@@ -304,6 +304,18 @@ TEST_F(GpuDatasetUpload, fiberTablesThatDoNotCoverTheFibletsAreRefused) {
         }
       },
       Error);
+  // An entry beyond the fiblets, the order restored after it: refused
+  // before the per-fiblet table is filled past its end.
+  std::swap(encoded.fiber_first_fiblet[3], encoded.fiber_first_fiblet[4]);
+  encoded.fiber_first_fiblet[2] = 1u << 30;
+  try {
+    GpuDataset::upload(context(), encoded, params, length, "beyond");
+    ADD_FAILURE() << "a fiber table beyond the fiblets was uploaded";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("beyond: fiber_first_fiblet[2] is 1073741824, beyond the fiblet count", 0),
+              0u)
+        << e.what();
+  }
   const std::vector<float> short_length(3, 1.0f);
   EXPECT_THROW(GpuDataset::upload(context(), encoded, params, short_length, "short"), Error);
 }
