@@ -9,6 +9,7 @@
 #include "app/commands.h"
 #include "app/open_input.h"
 #include "codec/compressor.h"
+#include "core/error.h"
 #include "core/progress.h"
 
 namespace fibscope {
@@ -146,6 +147,8 @@ void addCompressCommand(CLI::App& app) {
   cmd->callback([opt] {
     if (opt->compress.params.points_per_fiblet % 4 != 0)
       throw CLI::ValidationError("--points", "must be a multiple of 4");
+    // Other tools would take an .fbl under another extension for that format.
+    if (!isFblPath(opt->output)) fail(opt->output, "the output of compress must be a .fbl file");
     CompressOptions options = opt->compress;
     options.overwrite = opt->force;
     if (opt->open_loop) options.encode.mode = EncodeMode::OpenLoop;

@@ -163,6 +163,9 @@ TEST(CompressCli, givenFibletSizeStepAndAngleAreUsedAndReported) {
   const FblFile f = FblFile::open(dir.file("p.fbl"));
   EXPECT_EQ(f.header().points_per_fiblet, 32u);
   EXPECT_EQ(f.header().fiblet_record_bytes, 44u);  // 32 + 11 rounded up to 4
+  const auto wrong = runFibscope("compress " + tck + " " + dir.file("p.tck"));
+  EXPECT_EQ(wrong.exit_code, 2) << wrong.output;
+  EXPECT_NE(wrong.output.find(".fbl"), std::string::npos) << wrong.output;
   // N must be a multiple of 4 in [8, 60].
   for (const char* bad : {"--points 30", "--points 4", "--points 64"}) {
     const auto e = runFibscope("compress " + tck + " " + dir.file("bad.fbl") + " " + bad);
