@@ -37,8 +37,8 @@ FiberTables deriveFiberTables(const std::string& name, std::span<const T> first,
   if (uint64_t(first[0]) != 0)
     fail(name, "fiber_first_fiblet[0] is " + std::to_string(uint64_t(first[0])) + ", expected 0");
   if (uint64_t(first[fibers]) != fiblets)
-    fail(name, "fiber_first_fiblet ends at " + std::to_string(uint64_t(first[fibers])) + ", expected the fiblet count " +
-                   std::to_string(fiblets));
+    fail(name, "fiber_first_fiblet ends at " + std::to_string(uint64_t(first[fibers])) +
+                   ", expected the fiblet count " + std::to_string(fiblets));
   FiberTables tables;
   tables.first.resize(fibers + 1);
   tables.fiblet_fiber.resize(fiblets);
@@ -143,14 +143,14 @@ void checkDatasetFits(const std::string& name, uint64_t fibers, uint64_t fiblets
   // Name the single buffer when it, not the total, is what does not fit.
   const std::string buffer_note =
       total <= limits.device_local_heap_bytes
-          ? "the fiblet records need one buffer of " + formatBytes(double(bytes.largest())) + "; "
+          ? std::string(bytes.largest() == bytes.records ? "the fiblet records need" : "one table needs") +
+                " one buffer of " + formatBytes(double(bytes.largest())) + "; "
           : std::string();
-  const std::string what = formatBytes(double(total)) + " of fiblets and tables do not fit on " +
-                           limits.device_name + " (" + buffer_note + "largest allocation " +
+  const std::string what = formatBytes(double(total)) + " of fiblets and tables do not fit on " + limits.device_name +
+                           " (" + buffer_note + "largest allocation " +
                            formatBytes(double(limits.max_allocation_bytes)) + ", largest buffer " +
                            formatBytes(double(limits.max_buffer_bytes)) + ", device-local heap " +
-                           formatBytes(double(limits.device_local_heap_bytes)) +
-                           "); streaming is not implemented yet";
+                           formatBytes(double(limits.device_local_heap_bytes)) + "); streaming is not implemented yet";
   fail(name, what);
 }
 
@@ -207,51 +207,44 @@ struct GpuDataset::Source {
 void GpuDataset::fill(const gpu::VulkanContext& context, const Source& source, const DatasetBytes& bytes,
                       Progress* progress, uint64_t staging_bytes) {
   context_ = &context;
-  gpu::Buffer& records = records_;
-  gpu::Buffer& fiblet_fiber = fiblet_fiber_;
-  gpu::Buffer& directions = directions_;
-  gpu::Buffer& first = fiber_first_fiblet_;
-  gpu::Buffer& length = fiber_length_;
-  gpu::Buffer& block_buffer = block_buffer_;
-  shader::FibletDataset& block = block_;
-  records = gpu::createBuffer(context, bufferSize(bytes.records), gpu::MemoryUse::DeviceLocal);
-  fiblet_fiber = gpu::createBuffer(context, bufferSize(bytes.fiblet_fiber), gpu::MemoryUse::DeviceLocal);
-  directions = gpu::createBuffer(context, bufferSize(bytes.directions), gpu::MemoryUse::DeviceLocal);
-  first = gpu::createBuffer(context, bufferSize(bytes.fiber_first_fiblet), gpu::MemoryUse::DeviceLocal);
-  length = gpu::createBuffer(context, bufferSize(bytes.fiber_length), gpu::MemoryUse::DeviceLocal);
-  block_buffer = gpu::createBuffer(context, bufferSize(bytes.block), gpu::MemoryUse::DeviceLocal);
+  records_ = gpu::createBuffer(context, bufferSize(bytes.records), gpu::MemoryUse::DeviceLocal);
+  fiblet_fiber_ = gpu::createBuffer(context, bufferSize(bytes.fiblet_fiber), gpu::MemoryUse::DeviceLocal);
+  directions_ = gpu::createBuffer(context, bufferSize(bytes.directions), gpu::MemoryUse::DeviceLocal);
+  fiber_first_fiblet_ = gpu::createBuffer(context, bufferSize(bytes.fiber_first_fiblet), gpu::MemoryUse::DeviceLocal);
+  fiber_length_ = gpu::createBuffer(context, bufferSize(bytes.fiber_length), gpu::MemoryUse::DeviceLocal);
+  block_buffer_ = gpu::createBuffer(context, bufferSize(bytes.block), gpu::MemoryUse::DeviceLocal);
 
   const CodecParams& params = source.params;
-  block.records = records.address;
-  block.fiblet_fiber = fiblet_fiber.address;
-  block.directions = directions.address;
-  block.fiber_first_fiblet = first.address;
-  block.fiber_length_mm = length.address;
-  block.fiber_count = uint32_t(source.tables.first.size() - 1);
-  block.fiblet_count = uint32_t(source.tables.fiblet_fiber.size());
-  block.record_words = params.recordBytes() / 4;
-  block.points_per_fiblet = params.points_per_fiblet;
-  block.translation_x = params.translation[0];
-  block.translation_y = params.translation[1];
-  block.translation_z = params.translation[2];
-  block.mm_per_unit = float(1.0 / double(params.scale));
-  block.delta = params.delta;
-  block.v_x = params.v[0];
-  block.v_y = params.v[1];
-  block.v_z = params.v[2];
+  block_.records = records_.address;
+  block_.fiblet_fiber = fiblet_fiber_.address;
+  block_.directions = directions_.address;
+  block_.fiber_first_fiblet = fiber_first_fiblet_.address;
+  block_.fiber_length_mm = fiber_length_.address;
+  block_.fiber_count = uint32_t(source.tables.first.size() - 1);
+  block_.fiblet_count = uint32_t(source.tables.fiblet_fiber.size());
+  block_.record_words = params.recordBytes() / 4;
+  block_.points_per_fiblet = params.points_per_fiblet;
+  block_.translation_x = params.translation[0];
+  block_.translation_y = params.translation[1];
+  block_.translation_z = params.translation[2];
+  block_.mm_per_unit = float(1.0 / double(params.scale));
+  block_.delta = params.delta;
+  block_.v_x = params.v[0];
+  block_.v_y = params.v[1];
+  block_.v_z = params.v[2];
   const FibletDirectionTable table = buildDirectionTable(params.alpha);
 
   if (progress) progress->setTotal(double(bytes.total()));
-  gpu::Buffer staging =
-      gpu::createBuffer(context, std::clamp<uint64_t>(bytes.largest(), 4, std::max<uint64_t>(staging_bytes, 4)),
-                        gpu::MemoryUse::Upload);
+  gpu::Buffer staging = gpu::createBuffer(
+      context, std::clamp<uint64_t>(bytes.largest(), 4, std::max<uint64_t>(staging_bytes, 4)), gpu::MemoryUse::Upload);
   try {
-    uploadChunked(context, staging, records, source.records.data(), bytes.records, progress);
-    uploadChunked(context, staging, fiblet_fiber, source.tables.fiblet_fiber.data(), bytes.fiblet_fiber, progress);
-    uploadChunked(context, staging, directions, table.data(), bytes.directions, progress);
-    uploadChunked(context, staging, first, source.tables.first.data(), bytes.fiber_first_fiblet, progress);
-    uploadChunked(context, staging, length, source.fiber_length_mm.data(), bytes.fiber_length, progress);
-    uploadChunked(context, staging, block_buffer, &block, bytes.block, progress);
+    uploadChunked(context, staging, records_, source.records.data(), bytes.records, progress);
+    uploadChunked(context, staging, fiblet_fiber_, source.tables.fiblet_fiber.data(), bytes.fiblet_fiber, progress);
+    uploadChunked(context, staging, directions_, table.data(), bytes.directions, progress);
+    uploadChunked(context, staging, fiber_first_fiblet_, source.tables.first.data(), bytes.fiber_first_fiblet,
+                  progress);
+    uploadChunked(context, staging, fiber_length_, source.fiber_length_mm.data(), bytes.fiber_length, progress);
+    uploadChunked(context, staging, block_buffer_, &block_, bytes.block, progress);
   } catch (...) {
     gpu::destroyBuffer(context, staging);
     throw;
@@ -280,8 +273,8 @@ GpuDataset GpuDataset::upload(const gpu::VulkanContext& context, const FblFile& 
   const FblSection& first_section = section(kFblSectionFiberFirstFiblet, FblDType::kUint64);
   const FblSection& length_section = section(kFblSectionFiberLength, FblDType::kFloat32);
   if (fiblet_section.bytes % record_bytes != 0)
-    fail(name, "section \"fiblets\" has " + std::to_string(fiblet_section.bytes) +
-                   " bytes, not a whole number of " + std::to_string(record_bytes) + "-byte records");
+    fail(name, "section \"fiblets\" has " + std::to_string(fiblet_section.bytes) + " bytes, not a whole number of " +
+                   std::to_string(record_bytes) + "-byte records");
   const uint64_t fiblets = fiblet_section.bytes / record_bytes;
   if (first_section.element_count == 0) fail(name, "section \"fiber_first_fiblet\" is empty, expected fibers + 1");
   const uint64_t fibers = first_section.element_count - 1;
@@ -315,8 +308,8 @@ GpuDataset GpuDataset::upload(const gpu::VulkanContext& context, const EncodedFi
   const uint32_t record_bytes = params.recordBytes();
   if (fiblets.record_bytes != record_bytes || fiblets.bytes.size() % record_bytes != 0)
     fail(name, std::to_string(fiblets.bytes.size()) + " bytes of " + std::to_string(fiblets.record_bytes) +
-                   "-byte records, expected whole " + std::to_string(record_bytes) + "-byte records for N = " +
-                   std::to_string(params.points_per_fiblet));
+                   "-byte records, expected whole " + std::to_string(record_bytes) +
+                   "-byte records for N = " + std::to_string(params.points_per_fiblet));
   const uint64_t count = fiblets.fibletCount();
   const uint64_t fibers = fiblets.fiber_first_fiblet.size();
   if (fiber_length_mm.size() != fibers)

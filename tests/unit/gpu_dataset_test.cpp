@@ -211,8 +211,7 @@ TEST_F(GpuDatasetUpload, encodedFibletsUploadEqualsTheFileUpload) {
   ASSERT_TRUE(sameBytes(encoded.bytes, file.data(kFblSectionFiblets)))
       << "the in-memory encode differs from the compressor's";
   const auto length = file.array<float>(*file.find(kFblSectionFiberLength));
-  const GpuDataset dataset =
-      GpuDataset::upload(context(), encoded, params, length, "phantom (in memory)");
+  const GpuDataset dataset = GpuDataset::upload(context(), encoded, params, length, "phantom (in memory)");
   expectMatchesFile(dataset, file);
 }
 
