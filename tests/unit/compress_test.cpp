@@ -377,10 +377,10 @@ TEST(FastDirectionQuantizer, blockHoldsTheExactCellAndMatchesTheExactBlockAwayFr
   }
 }
 
-TEST(Compressor, blockSizesTwoAndThreeGiveTheSameErrorsAndOneIsWorse) {
+TEST(Compressor, blockSizesTwoThreeAndFiveGiveTheSameErrorsAndOneIsWorse) {
   TempDir dir;
   std::map<int, CompressReport> by_size;
-  for (int size : {1, 2, 3}) {
+  for (int size : {1, 2, 3, 5}) {
     CompressOptions options = quietOptions();
     options.encode.search_size = size;
     by_size[size] =
@@ -391,6 +391,8 @@ TEST(Compressor, blockSizesTwoAndThreeGiveTheSameErrorsAndOneIsWorse) {
             << by_size[2].error.mean_um << " / " << by_size[3].error.mean_um << "\n";
   EXPECT_NEAR(by_size[2].error.max_um, by_size[3].error.max_um, 0.02 * by_size[3].error.max_um);
   EXPECT_NEAR(by_size[2].error.mean_um, by_size[3].error.mean_um, 0.01 * by_size[3].error.mean_um);
+  EXPECT_NEAR(by_size[2].error.max_um, by_size[5].error.max_um, 0.02 * by_size[5].error.max_um);
+  EXPECT_NEAR(by_size[2].error.mean_um, by_size[5].error.mean_um, 0.01 * by_size[5].error.mean_um);
   EXPECT_GT(by_size[1].error.mean_um, by_size[2].error.mean_um);
 }
 
