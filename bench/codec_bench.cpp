@@ -26,6 +26,7 @@
 #include "codec/fiblet_decoder.h"
 #include "codec/fiblet_encoder.h"
 #include "core/thread_pool.h"
+#include "io/reader.h"
 #include "phantom/phantom.h"
 
 namespace fibscope {
@@ -36,10 +37,7 @@ const Tractogram& benchPhantom() {
     PhantomOptions options;
     options.streamlines = 2000;
     options.seed = 3;
-    auto reader = openPhantom(options);
-    Tractogram all, chunk;
-    while (reader->read(chunk)) all.append(chunk);
-    return all;
+    return readAllStreamlines(*openPhantom(options));
   }();
   return tractogram;
 }

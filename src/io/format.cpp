@@ -47,13 +47,18 @@ std::unique_ptr<TractogramReader> openTractogram(const std::string& path) {
   fail(path, "unknown tractogram format '" + ext + "' (expected .tck, .trk, .trx or .vtk)");
 }
 
+Tractogram readAllStreamlines(TractogramReader& reader) {
+  Tractogram all;
+  for (const auto& a : reader.header().per_streamline) all.per_streamline.push_back({a.name, a.components, a.dtype, {}});
+  for (const auto& a : reader.header().per_point) all.per_point.push_back({a.name, a.components, a.dtype, {}});
+  Tractogram chunk;
+  while (reader.read(chunk)) all.append(chunk);
+  return all;
+}
+
 Tractogram readTractogram(const std::string& path, TractogramHeader* header, std::vector<std::string>* warnings) {
   auto reader = openTractogram(path);
-  Tractogram all;
-  for (const auto& a : reader->header().per_streamline) all.per_streamline.push_back({a.name, a.components, a.dtype, {}});
-  for (const auto& a : reader->header().per_point) all.per_point.push_back({a.name, a.components, a.dtype, {}});
-  Tractogram chunk;
-  while (reader->read(chunk)) all.append(chunk);
+  Tractogram all = readAllStreamlines(*reader);
   if (header) *header = reader->header();
   if (warnings) warnings->insert(warnings->end(), reader->warnings().begin(), reader->warnings().end());
   return all;

@@ -48,6 +48,10 @@ class TractogramReader {
 // headers that cannot be parsed.
 std::unique_ptr<TractogramReader> openTractogram(const std::string& path);
 
+// Reads every remaining streamline of `reader` into one tractogram whose
+// data arrays follow the reader's header (small inputs, tests).
+Tractogram readAllStreamlines(TractogramReader& reader);
+
 // Reads a whole file into memory (small files, tests). Warnings are appended
 // to `warnings` when given.
 Tractogram readTractogram(const std::string& path, TractogramHeader* header = nullptr,

@@ -225,8 +225,7 @@ TEST(Compressor, outputIsByteIdenticalForAnyThreadCountAndChunkSize) {
 
 TEST(Compressor, fiberTablesLengthsAndPerFiberDataAreStored) {
   TempDir dir;
-  Tractogram original, chunk;
-  for (auto reader = phantomReader(80); reader->read(chunk);) original.append(chunk);
+  const Tractogram original = readAllStreamlines(*phantomReader(80));
   CompressOptions options = quietOptions();
   options.chunk_points = 5000;
   const CompressReport report = compressTractogram([] { return phantomReader(80); }, dir.file("p.fbl"), options);
@@ -263,8 +262,8 @@ TEST(Compressor, variableStepsAreSplitOrResampledAndCounted) {
   TempDir dir;
   // Phantom fibers at 0.1 mm with every 7th interior point removed: one
   // step in six is 0.2 mm, as in a file thinned by a compressor.
-  Tractogram full, chunk, t;
-  for (auto reader = phantomReader(40); reader->read(chunk);) full.append(chunk);
+  const Tractogram full = readAllStreamlines(*phantomReader(40));
+  Tractogram t;
   for (size_t s = 0; s < full.streamlineCount(); ++s) {
     std::vector<float> xyz;
     for (size_t i = 0; i < full.pointsIn(s); ++i)

@@ -15,6 +15,7 @@
 #include "codec/fiblet_decoder.h"
 #include "codec/fiblet_encoder.h"
 #include "core/error.h"
+#include "io/reader.h"
 #include "phantom/phantom.h"
 #include "shared/fiblet.h"
 
@@ -35,10 +36,7 @@ const Tractogram& phantom(double step) {
   options.step_mm = step;
   options.seed = 7;
   options.threads = 1;
-  auto reader = openPhantom(options);
-  Tractogram all, chunk;
-  while (reader->read(chunk)) all.append(chunk);
-  return cache.emplace(step, std::move(all)).first->second;
+  return cache.emplace(step, readAllStreamlines(*openPhantom(options))).first->second;
 }
 
 double angleBetween(vec3 a, vec3 b) {

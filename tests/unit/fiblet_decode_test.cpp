@@ -13,6 +13,7 @@
 #include "codec/fiblet_decoder.h"
 #include "codec/fiblet_encoder.h"
 #include "codec/fiblet_simd.h"
+#include "io/reader.h"
 #include "phantom/phantom.h"
 #include "shared/fiblet.h"
 #include "test_support.h"
@@ -164,8 +165,7 @@ TEST(FibletDecode, vectorisedDecodersAreBitIdenticalToTheSharedScalarArithmetic)
   options.streamlines = 60;
   options.seed = 4;
   options.threads = 1;
-  Tractogram t, chunk;
-  for (auto reader = openPhantom(options); reader->read(chunk);) t.append(chunk);
+  const Tractogram t = readAllStreamlines(*openPhantom(options));
   for (uint32_t n : {8u, 60u}) {
     CodecParamOptions po;
     po.points_per_fiblet = n;

@@ -22,6 +22,7 @@
 #include "core/error.h"
 #include "gpu/submit.h"
 #include "gpu_test_context.h"
+#include "io/reader.h"
 #include "phantom/phantom.h"
 #include "render/gpu_dataset.h"
 #include "shared/dataset_decode_push.h"
@@ -204,8 +205,7 @@ TEST_F(GpuDatasetUpload, passReadingOnlyTheBlockDecodesBitForBitLikeTheCpuScan) 
 TEST_F(GpuDatasetUpload, encodedFibletsUploadEqualsTheFileUpload) {
   const FblFile file = FblFile::open(compressPhantom(dir_, 60));
   const CodecParams params = codecParamsFromFbl(file.header(), file.path());
-  Tractogram phantom, chunk;
-  for (auto reader = phantomReader(); reader->read(chunk);) phantom.append(chunk);
+  const Tractogram phantom = readAllStreamlines(*phantomReader());
   // Compression on the fly: the same parameters, encoded in memory.
   const EncodedFiblets encoded = encodeTractogram(phantom, params);
   ASSERT_TRUE(sameBytes(encoded.bytes, file.data(kFblSectionFiblets)))

@@ -16,6 +16,7 @@
 #include "codec/fiblet_encoder.h"
 #include "gpu/submit.h"
 #include "gpu_test_context.h"
+#include "io/reader.h"
 #include "phantom/phantom.h"
 #include "shared/fiblet_decode_push.h"
 
@@ -30,10 +31,7 @@ Tractogram phantomTractogram() {
   options.step_mm = 0.1;
   options.seed = 11;
   options.threads = 1;
-  auto reader = openPhantom(options);
-  Tractogram all, chunk;
-  while (reader->read(chunk)) all.append(chunk);
-  return all;
+  return readAllStreamlines(*openPhantom(options));
 }
 
 struct GpuDecoded {

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "io/reader.h"
 #include "phantom/phantom.h"
 #include "render/camera.h"
 #include "render/image_compare.h"
@@ -432,10 +433,7 @@ TEST(ReferenceRaster, RejectsLineWidthsOutsideOneToFour) {
 }
 
 Tractogram readPhantom(const PhantomOptions& options) {
-  auto reader = openPhantom(options);
-  Tractogram all, chunk;
-  while (reader->read(chunk)) all.append(chunk);
-  return all;
+  return readAllStreamlines(*openPhantom(options));
 }
 
 TEST(ReferenceRaster, PhantomInTheStandardViewsLooksLikeABrain) {
