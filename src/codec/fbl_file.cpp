@@ -40,7 +40,9 @@ std::string printable(const uint8_t* p, size_t n) {
 }
 
 std::string quoted(const std::string& name) {
-  return "'" + printable(reinterpret_cast<const uint8_t*>(name.data()), name.size()) + "'";
+  std::string out = "'";
+  out += printable(reinterpret_cast<const uint8_t*>(name.data()), name.size());
+  return out += '\'';
 }
 
 bool allZero(const uint8_t* p, size_t n) {

@@ -45,7 +45,11 @@ bool isAllDigits(std::string_view s) {
   return true;
 }
 
-std::string quoted(std::string_view s) { return "'" + printableExcerpt(s) + "'"; }
+std::string quoted(std::string_view s) {
+  std::string out = "'";
+  out += printableExcerpt(s);
+  return out += '\'';
+}
 
 // The value of a key that must appear at most once with one meaning
 // (datatype, file): repeated identical lines are tolerated.

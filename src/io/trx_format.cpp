@@ -175,8 +175,9 @@ std::string memberFileName(const std::string& name, uint32_t components, DType d
   const size_t dot = name.rfind('.');
   const bool name_ends_in_number = dot != std::string::npos && allDigits(std::string_view(name).substr(dot + 1));
   std::string file = name;
-  if (components != 1 || name_ends_in_number) file += "." + std::to_string(components);
-  return file + "." + dtypeName(dtype);
+  if (components != 1 || name_ends_in_number) (file += '.') += std::to_string(components);
+  (file += '.') += dtypeName(dtype);
+  return file;
 }
 
 bool isValidArrayName(std::string_view name) {
