@@ -33,21 +33,6 @@ struct ChunkJob {
   ResampleReport resample;
 };
 
-// Arc length of a polyline in mm, over its finite segments. Each segment's
-// length in single precision (sqrtss: a per-segment sqrtsd was a visible
-// part of the compressor's time), summed in double.
-float polylineLength(const float* p, size_t n) {
-  double length = 0;
-  for (size_t i = 1; i < n; ++i) {
-    const float* a = p + 3 * (i - 1);
-    const float* b = a + 3;
-    const double dx = double(b[0]) - a[0], dy = double(b[1]) - a[1], dz = double(b[2]) - a[2];
-    const float d = std::sqrt(float(dx * dx + dy * dy + dz * dz));
-    if (std::isfinite(d)) length += d;
-  }
-  return float(length);
-}
-
 void encodeChunk(FibletEncoder& encoder, ChunkJob& job, bool resample, double delta_mm) {
   const Tractogram& in = job.input;
   // What openFbl accepts: one fiber is decoded whole into memory.

@@ -1,6 +1,7 @@
 #include "core/tractogram.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace fibscope {
 
@@ -54,6 +55,18 @@ std::string TractogramHeader::property(const std::string& key) const {
   for (const auto& [k, v] : properties)
     if (k == key) return v;
   return {};
+}
+
+float polylineLength(const float* p, size_t n) {
+  double length = 0;
+  for (size_t i = 1; i < n; ++i) {
+    const float* a = p + 3 * (i - 1);
+    const float* b = a + 3;
+    const double dx = double(b[0]) - a[0], dy = double(b[1]) - a[1], dz = double(b[2]) - a[2];
+    const float d = std::sqrt(float(dx * dx + dy * dy + dz * dz));
+    if (std::isfinite(d)) length += d;
+  }
+  return float(length);
 }
 
 }  // namespace fibscope

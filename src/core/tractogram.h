@@ -83,4 +83,10 @@ struct TractogramHeader {
   std::string property(const std::string& key) const;
 };
 
+// Arc length in mm of the polyline of `n` points at `p` (x y z each), over
+// its finite segments. Each segment's length in single precision (sqrtss: a
+// per-segment sqrtsd was a visible part of the compressor's time), summed in
+// double.
+float polylineLength(const float* p, size_t n);
+
 }  // namespace fibscope

@@ -1,0 +1,28 @@
+// Reading fiblet records (shared/fiblet.h layout) through a dataset block.
+#ifndef FIBSCOPE_GLSL_FIBLET_RECORD_GLSL
+#define FIBSCOPE_GLSL_FIBLET_RECORD_GLSL
+
+#include "shared/fiblet.h"
+#include "glsl/render_buffers.glsl"
+
+uint fibletRecordByte(WordsRef records, uint base, uint byte_index) {
+  return fibletByteOfWord(records.words[base + byte_index / 4u], byte_index);
+}
+
+// Point 0 or 1 of a record (16-bit coordinates), normalised units.
+vec3 fibletRecordPoint(uint w0, uint w1, uint w2, uint which) {
+  return vec3(fibletDequantize(fibletCoordOfWords(w0, w1, w2, 3u * which)),
+              fibletDequantize(fibletCoordOfWords(w0, w1, w2, 3u * which + 1u)),
+              fibletDequantize(fibletCoordOfWords(w0, w1, w2, 3u * which + 2u)));
+}
+
+vec3 fibletFirstPoint(WordsRef records, uint base) {
+  return fibletRecordPoint(records.words[base], records.words[base + 1u], records.words[base + 2u], 0u);
+}
+
+// Normalised -> world mm (FibletDataset: p_mm = translation + mm_per_unit * p_n).
+vec3 fibletToWorld(FibletDataset ds, vec3 p) {
+  return vec3(ds.translation_x, ds.translation_y, ds.translation_z) + ds.mm_per_unit * p;
+}
+
+#endif

@@ -1,0 +1,43 @@
+// The compute pipeline's decode + raster and resolve passes (DESIGN.md
+// section 6, steps 2 and 3): shaders/fiblet_raster.comp and
+// shaders/fiblet_resolve.comp, and the functions that record them. The cull
+// passes that feed the raster a list live in gpu_cull_passes.h.
+//
+// Recording functions bind, push and dispatch only; the caller (the frame
+// renderer) places the barriers between passes and the timestamps.
+#pragma once
+
+#include <vulkan/vulkan.h>
+
+#include "gpu/buffer.h"
+#include "gpu/compute_pipeline.h"
+#include "gpu/vulkan_context.h"
+#include "render/gpu_dataset.h"
+#include "render/gpu_frame_targets.h"
+
+namespace fibscope {
+
+struct FibletPasses {
+  gpu::ComputePipeline raster;   // fiblet_raster.comp
+  gpu::ComputePipeline resolve;  // fiblet_resolve.comp
+};
+
+FibletPasses createFibletPasses(const gpu::VulkanContext& context);
+void destroyFibletPasses(const gpu::VulkanContext& context, FibletPasses& passes);
+
+// Every fiblet of the dataset, one workgroup each.
+void recordFibletRasterAll(VkCommandBuffer cmd, const gpu::VulkanContext& context, const FibletPasses& passes,
+                           const GpuDataset& dataset, const GpuFrameTargets& frame);
+// The fiblets of `list` (shared/fiblet_list.h), dispatched indirectly from
+// the list's header; the list must have been finalised (dispatch size
+// written) and made visible to indirect reads.
+void recordFibletRasterList(VkCommandBuffer cmd, const FibletPasses& passes, const GpuDataset& dataset,
+                            const GpuFrameTargets& frame, const gpu::Buffer& list);
+void recordFibletResolve(VkCommandBuffer cmd, const FibletPasses& passes, const GpuDataset& dataset,
+                         const GpuFrameTargets& frame);
+
+// Workgroups of kPixelGroupSize^2 covering the frame.
+uint32_t pixelGroupsX(const GpuFrameTargets& frame);
+uint32_t pixelGroupsY(const GpuFrameTargets& frame);
+
+}  // namespace fibscope

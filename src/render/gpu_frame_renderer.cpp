@@ -1,0 +1,104 @@
+#include "render/gpu_frame_renderer.h"
+
+#include <string>
+
+#include "core/error.h"
+#include "gpu/submit.h"
+#include "render/reference_raster.h"
+
+namespace fibscope {
+namespace {
+
+// Compute writes by one pass made visible to compute reads of the next.
+void computeToCompute(VkCommandBuffer cmd) {
+  gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                     VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT,
+                     VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                     VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+}
+
+constexpr uint32_t kMaxPassesPerFrame = 16;
+
+}  // namespace
+
+FrameRenderer::FrameRenderer(const gpu::VulkanContext& context, uint32_t width, uint32_t height) : context_(context) {
+  try {
+    targets_ = createFrameTargets(context, width, height);
+    fiblet_passes_ = createFibletPasses(context);
+    timer_ = gpu::createGpuTimer(context, kMaxPassesPerFrame);
+  } catch (...) {
+    release();
+    throw;
+  }
+}
+
+FrameRenderer::~FrameRenderer() { release(); }
+
+void FrameRenderer::release() {
+  gpu::destroyGpuTimer(context_, timer_);
+  destroyFibletPasses(context_, fiblet_passes_);
+  destroyFrameTargets(context_, targets_);
+}
+
+void FrameRenderer::resize(uint32_t width, uint32_t height) {
+  if (width == targets_.width && height == targets_.height) return;
+  vkDeviceWaitIdle(context_.device());
+  GpuFrameTargets fresh = createFrameTargets(context_, width, height);
+  destroyFrameTargets(context_, targets_);
+  targets_ = fresh;
+}
+
+void FrameRenderer::record(VkCommandBuffer cmd, const Camera& camera, const RenderSettings& settings,
+                           const GpuScene& scene) {
+  if (camera.width != targets_.width || camera.height != targets_.height)
+    throw Error("render: camera is " + std::to_string(camera.width) + " x " + std::to_string(camera.height) +
+                " px, the frame " + std::to_string(targets_.width) + " x " + std::to_string(targets_.height));
+  if (!(settings.line_width_px >= kMinLineWidth && settings.line_width_px <= kMaxLineWidth))
+    throw Error("render: line width must lie in [1, 4] px, got " + std::to_string(settings.line_width_px));
+  if (settings.pipeline == RenderPipeline::Compute && !scene.fiblets)
+    throw Error("render: the compute pipeline needs fiblets");
+  if (settings.pipeline != RenderPipeline::Compute)
+    throw Error("render: pipeline '" + std::string(renderPipelineName(settings.pipeline)) + "' is not built yet");
+
+  pending_ = {};
+  gpu::resetGpuTimer(cmd, timer_);
+
+  // Frame setup: the camera block and an empty visibility buffer.
+  gpu::beginPass(cmd, timer_, "clear");
+  const shader::CameraBlock block = makeCameraBlock(camera, settings.line_width_px);
+  vkCmdUpdateBuffer(cmd, targets_.camera.buffer, 0, sizeof(block), &block);
+  vkCmdFillBuffer(cmd, targets_.visibility.buffer, 0, VK_WHOLE_SIZE, 0xFFFFFFFFu);
+  gpu::endPass(cmd, timer_);
+  gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                     VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                     VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+
+  const GpuDataset& dataset = *scene.fiblets;
+  pending_.fiblets_total = dataset.block().fiblet_count;
+  gpu::beginPass(cmd, timer_, "raster");
+  recordFibletRasterAll(cmd, context_, fiblet_passes_, dataset, targets_);
+  gpu::endPass(cmd, timer_);
+  pending_.fiblets_drawn = pending_.fiblets_total;
+  computeToCompute(cmd);
+
+  gpu::beginPass(cmd, timer_, "resolve");
+  recordFibletResolve(cmd, fiblet_passes_, dataset, targets_);
+  gpu::endPass(cmd, timer_);
+  computeToCompute(cmd);
+}
+
+FrameStats FrameRenderer::collect() {
+  FrameStats stats = pending_;
+  for (const gpu::PassTime& t : gpu::readGpuTimer(context_, timer_)) {
+    stats.passes.push_back({t.name, t.ms});
+    stats.gpu_ms += t.ms;
+  }
+  return stats;
+}
+
+FrameStats FrameRenderer::render(const Camera& camera, const RenderSettings& settings, const GpuScene& scene) {
+  gpu::submitOnce(context_, [&](VkCommandBuffer cmd) { record(cmd, camera, settings, scene); });
+  return collect();
+}
+
+}  // namespace fibscope

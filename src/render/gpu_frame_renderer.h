@@ -1,0 +1,63 @@
+// Draws frames: runs the passes of the chosen pipeline into the shared
+// frame targets (G-buffer, then the shaded RGBA8 image) with timestamps
+// around every pass (DESIGN.md section 6). One renderer per frame size; it
+// keeps the state that spans frames (pipelines, scratch buffers, the
+// previous frame's visible fiblets for two-phase culling).
+#pragma once
+
+#include <vulkan/vulkan.h>
+
+#include <cstdint>
+#include <vector>
+
+#include "gpu/gpu_timer.h"
+#include "gpu/vulkan_context.h"
+#include "render/camera.h"
+#include "render/gpu_dataset.h"
+#include "render/gpu_fiblet_passes.h"
+#include "render/gpu_frame_targets.h"
+#include "render/render_settings.h"
+
+namespace fibscope {
+
+// What a frame draws: the fiblets (compute pipeline) and, for the
+// baselines, the same tractogram as raw float vertices. A pipeline whose
+// input is missing is an Error when the frame is recorded.
+struct GpuScene {
+  const GpuDataset* fiblets = nullptr;
+};
+
+class FrameRenderer {
+ public:
+  // Throws Error when a pipeline cannot be created or memory runs out.
+  FrameRenderer(const gpu::VulkanContext& context, uint32_t width, uint32_t height);
+  ~FrameRenderer();
+  FrameRenderer(const FrameRenderer&) = delete;
+  FrameRenderer& operator=(const FrameRenderer&) = delete;
+
+  // New frame size (waits for the device to be idle).
+  void resize(uint32_t width, uint32_t height);
+
+  // Records one whole frame into `cmd` (the camera's size must be the
+  // renderer's). Throws Error for a missing scene input or settings out of
+  // range (line width outside [1, 4]).
+  void record(VkCommandBuffer cmd, const Camera& camera, const RenderSettings& settings, const GpuScene& scene);
+  // The statistics of the frame last recorded, once its submission has
+  // completed.
+  FrameStats collect();
+  // record + submit + wait + collect.
+  FrameStats render(const Camera& camera, const RenderSettings& settings, const GpuScene& scene);
+
+  const GpuFrameTargets& targets() const { return targets_; }
+
+ private:
+  void release();
+
+  const gpu::VulkanContext& context_;
+  GpuFrameTargets targets_;
+  FibletPasses fiblet_passes_;
+  gpu::GpuTimer timer_;
+  FrameStats pending_;
+};
+
+}  // namespace fibscope

@@ -1,0 +1,58 @@
+#include "render/gpu_frame_targets.h"
+
+#include <string>
+
+#include "core/error.h"
+
+namespace fibscope {
+
+namespace {
+constexpr uint32_t kMaxFrameSide = 16384;
+}
+
+GpuFrameTargets createFrameTargets(const gpu::VulkanContext& context, uint32_t width, uint32_t height) {
+  if (width == 0 || height == 0 || width > kMaxFrameSide || height > kMaxFrameSide)
+    throw Error("frame size must be 1 to " + std::to_string(kMaxFrameSide) + " px per side, got " +
+                std::to_string(width) + " x " + std::to_string(height));
+  GpuFrameTargets t;
+  t.width = width;
+  t.height = height;
+  try {
+    t.camera = gpu::createBuffer(context, sizeof(shader::CameraBlock), gpu::MemoryUse::DeviceLocal);
+    t.visibility = gpu::createBuffer(context, t.pixels() * sizeof(uint64_t), gpu::MemoryUse::DeviceLocal);
+    t.gbuffer = gpu::createBuffer(context, t.pixels() * sizeof(shader::GBufferTexel), gpu::MemoryUse::DeviceLocal);
+    t.color = gpu::createBuffer(context, t.pixels() * sizeof(uint32_t), gpu::MemoryUse::DeviceLocal);
+  } catch (...) {
+    destroyFrameTargets(context, t);
+    throw;
+  }
+  return t;
+}
+
+void destroyFrameTargets(const gpu::VulkanContext& context, GpuFrameTargets& targets) {
+  gpu::destroyBuffer(context, targets.color);
+  gpu::destroyBuffer(context, targets.gbuffer);
+  gpu::destroyBuffer(context, targets.visibility);
+  gpu::destroyBuffer(context, targets.camera);
+  targets = {};
+}
+
+std::vector<uint8_t> downloadColor(const gpu::VulkanContext& context, const GpuFrameTargets& targets) {
+  std::vector<uint8_t> rgba(targets.pixels() * 4);
+  gpu::downloadFromBuffer(context, targets.color, rgba.data(), rgba.size());
+  return rgba;
+}
+
+std::vector<shader::GBufferTexel> downloadGBuffer(const gpu::VulkanContext& context, const GpuFrameTargets& targets) {
+  std::vector<shader::GBufferTexel> texels(targets.pixels());
+  gpu::downloadFromBuffer(context, targets.gbuffer, texels.data(), texels.size() * sizeof(shader::GBufferTexel));
+  return texels;
+}
+
+std::vector<uint64_t> downloadVisibility(const gpu::VulkanContext& context, const GpuFrameTargets& targets) {
+  std::vector<uint64_t> keys(targets.pixels());
+  gpu::downloadFromBuffer(context, targets.visibility, keys.data(), keys.size() * sizeof(uint64_t));
+  return keys;
+}
+
+}  // namespace fibscope

@@ -1,0 +1,37 @@
+// The per-frame GPU buffers every pipeline shares (DESIGN.md section 6): the
+// camera block, the 64-bit visibility buffer, the G-buffer and the shaded
+// RGBA8 output, all plain storage buffers reached by device address. The
+// lines baseline also needs an R32G32B32A32_UINT colour attachment and a
+// depth attachment; its pass owns those.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "gpu/buffer.h"
+#include "gpu/vulkan_context.h"
+#include "shared/camera.h"
+#include "shared/gbuffer.h"
+
+namespace fibscope {
+
+struct GpuFrameTargets {
+  uint32_t width = 0, height = 0;
+  gpu::Buffer camera;      // one CameraBlock, updated in the command buffer each frame
+  gpu::Buffer visibility;  // uint64_t key per pixel (shared/render_config.h)
+  gpu::Buffer gbuffer;     // GBufferTexel per pixel (shared/gbuffer.h)
+  gpu::Buffer color;       // RGBA8 per pixel as one uint (R in the low byte), top row first
+  uint64_t pixels() const { return uint64_t(width) * height; }
+};
+
+// Buffers for a width x height frame. Throws Error for an empty size, a
+// size above 16384 px per side, or when memory runs out.
+GpuFrameTargets createFrameTargets(const gpu::VulkanContext& context, uint32_t width, uint32_t height);
+void destroyFrameTargets(const gpu::VulkanContext& context, GpuFrameTargets& targets);
+
+// Read-backs for tests and PNG output (wait for the queue).
+std::vector<uint8_t> downloadColor(const gpu::VulkanContext& context, const GpuFrameTargets& targets);
+std::vector<shader::GBufferTexel> downloadGBuffer(const gpu::VulkanContext& context, const GpuFrameTargets& targets);
+std::vector<uint64_t> downloadVisibility(const gpu::VulkanContext& context, const GpuFrameTargets& targets);
+
+}  // namespace fibscope

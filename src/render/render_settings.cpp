@@ -1,0 +1,47 @@
+#include "render/render_settings.h"
+
+#include <string>
+
+#include "core/error.h"
+
+namespace fibscope {
+namespace {
+
+template <typename Enum, size_t N>
+Enum parseName(std::string_view what, std::string_view name, const std::pair<std::string_view, Enum> (&names)[N]) {
+  std::string accepted;
+  for (const auto& [text, value] : names) {
+    if (text == name) return value;
+    accepted += (accepted.empty() ? "" : ", ") + std::string(text);
+  }
+  throw Error(std::string(what) + ": unknown value '" + std::string(name) + "' (expected one of: " + accepted + ")");
+}
+
+template <typename Enum, size_t N>
+std::string_view nameOf(Enum value, const std::pair<std::string_view, Enum> (&names)[N]) {
+  for (const auto& [text, v] : names)
+    if (v == value) return text;
+  return "?";
+}
+
+constexpr std::pair<std::string_view, RenderPipeline> kPipelines[] = {
+    {"compute", RenderPipeline::Compute}, {"lines", RenderPipeline::Lines}, {"raw-compute", RenderPipeline::RawCompute}};
+constexpr std::pair<std::string_view, CullingMode> kCulling[] = {
+    {"none", CullingMode::None}, {"frustum", CullingMode::Frustum}, {"two-phase", CullingMode::TwoPhase}};
+constexpr std::pair<std::string_view, ColorMode> kColors[] = {
+    {"solid", ColorMode::Solid}, {"orientation", ColorMode::Orientation}, {"fiber", ColorMode::PerFiber}};
+constexpr std::pair<std::string_view, Lighting> kLighting[] = {
+    {"none", Lighting::None}, {"illuminated", Lighting::IlluminatedLines}};
+
+}  // namespace
+
+RenderPipeline parseRenderPipeline(std::string_view name) { return parseName("pipeline", name, kPipelines); }
+CullingMode parseCullingMode(std::string_view name) { return parseName("culling", name, kCulling); }
+ColorMode parseColorMode(std::string_view name) { return parseName("color", name, kColors); }
+Lighting parseLighting(std::string_view name) { return parseName("lighting", name, kLighting); }
+std::string_view renderPipelineName(RenderPipeline pipeline) { return nameOf(pipeline, kPipelines); }
+std::string_view cullingModeName(CullingMode mode) { return nameOf(mode, kCulling); }
+std::string_view colorModeName(ColorMode mode) { return nameOf(mode, kColors); }
+std::string_view lightingName(Lighting lighting) { return nameOf(lighting, kLighting); }
+
+}  // namespace fibscope
