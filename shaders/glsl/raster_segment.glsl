@@ -14,6 +14,8 @@
 #include "shared/render_config.h"
 #include "glsl/render_buffers.glsl"
 
+const float kSpanMargin = 1.0 / 64.0;
+
 // Step 2: both ends outside the same frustum plane.
 bool segmentOutsideFrustum(vec4 a, vec4 b) {
   return (a.x < -a.w && b.x < -b.w) || (a.x > a.w && b.x > b.w) || (a.y < -a.w && b.y < -b.w) ||
@@ -33,7 +35,13 @@ void rasterPixel(VisibilityRef vis, uint width, int px, int py, vec3 a, vec3 ab,
   float depth = a.z + t * ab.z;
   if (depth > 1.0) return;  // beyond the far plane
   if (!(depth > 0.0)) depth = 0.0;  // also maps -0.0, whose bits would sort last
-  atomicMin(vis.keys[uint(py) * width + uint(px)], visibilityKey(depth, payload));
+  // A plain load first: where the pixel already holds a nearer key (most
+  // fragments of a dense tractogram) the atomic is skipped. Keys only
+  // decrease, so a stale load can only let an atomic through, never skip a
+  // needed one.
+  const uint index = uint(py) * width + uint(px);
+  const uint64_t key = visibilityKey(depth, payload);
+  if (key < vis.keys[index]) atomicMin(vis.keys[index], key);
 }
 
 // Steps 1-7 for the world-space segment p0 -> p1.
@@ -78,8 +86,10 @@ void rasterSegment(VisibilityRef vis, CameraBlock cam, vec3 p0, vec3 p1, uint64_
     const float s1 = a[minor] + slope * (cm + radius - a[major]);
     const float span_lo = max(min(s0, s1), minor_lo_seg) - radius;
     const float span_hi = min(max(s0, s1), minor_hi_seg) + radius;
-    const float n_lo = max(ceil(span_lo - 0.5) - 1.0, 0.0);  // one pixel of margin for float rounding
-    const float n_hi = min(floor(span_hi - 0.5) + 1.0, extent_minor - 1.0);
+    // A margin of 1/64 px for float rounding in the span (the per-pixel
+    // test is exact).
+    const float n_lo = max(ceil(span_lo - 0.5 - kSpanMargin), 0.0);
+    const float n_hi = min(floor(span_hi - 0.5 + kSpanMargin), extent_minor - 1.0);
     for (float n = n_lo; n <= n_hi; n += 1.0) {
       const int px = x_major ? int(m) : int(n);
       const int py = x_major ? int(n) : int(m);

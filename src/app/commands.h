@@ -15,5 +15,7 @@ void addPhantomCommand(CLI::App& app);
 void addDecompressCommand(CLI::App& app);
 void addCompressCommand(CLI::App& app);
 void addGpuInfoCommand(CLI::App& app);
+void addRenderCommand(CLI::App& app);
+void addBenchCommand(CLI::App& app);
 
 }  // namespace fibscope

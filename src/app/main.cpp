@@ -16,6 +16,8 @@ int main(int argc, char** argv) {
   fibscope::addCompressCommand(app);
   fibscope::addDecompressCommand(app);
   fibscope::addGpuInfoCommand(app);
+  fibscope::addRenderCommand(app);
+  fibscope::addBenchCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

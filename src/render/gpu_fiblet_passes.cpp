@@ -1,14 +1,29 @@
 #include "render/gpu_fiblet_passes.h"
 
+#include <string>
+
+#include "core/error.h"
 #include "shared/render_config.h"
 #include "shared/render_push.h"
 
 namespace fibscope {
 
-FibletPasses createFibletPasses(const gpu::VulkanContext& context) {
+uint32_t defaultRasterLanes(const gpu::VulkanContext& context) {
+  uint32_t lanes = 8;
+  while (lanes < 64 && lanes < context.info().subgroup_size) lanes *= 2;
+  return lanes;
+}
+
+FibletPasses createFibletPasses(const gpu::VulkanContext& context, uint32_t raster_lanes) {
+  if (raster_lanes == 0) raster_lanes = defaultRasterLanes(context);
+  if (raster_lanes != 8 && raster_lanes != 16 && raster_lanes != 32 && raster_lanes != 64)
+    throw Error("fiblet raster: lanes per fiblet must be 8, 16, 32 or 64, got " + std::to_string(raster_lanes));
   FibletPasses passes;
+  passes.raster_lanes = raster_lanes;
   try {
-    passes.raster = gpu::createComputePipeline(context, "fiblet_raster.comp", sizeof(shader::FibletRasterPush));
+    const uint32_t specialization[] = {raster_lanes};
+    passes.raster = gpu::createComputePipeline(context, "fiblet_raster.comp", sizeof(shader::FibletRasterPush),
+                                               specialization);
     passes.resolve = gpu::createComputePipeline(context, "fiblet_resolve.comp", sizeof(shader::FibletResolvePush));
   } catch (...) {
     destroyFibletPasses(context, passes);

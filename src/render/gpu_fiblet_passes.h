@@ -20,9 +20,17 @@ namespace fibscope {
 struct FibletPasses {
   gpu::ComputePipeline raster;   // fiblet_raster.comp
   gpu::ComputePipeline resolve;  // fiblet_resolve.comp
+  uint32_t raster_lanes = 0;     // invocations per fiblet in the raster
 };
 
-FibletPasses createFibletPasses(const gpu::VulkanContext& context);
+// The raster's invocations per fiblet for a device: its subgroup size
+// clamped to [8, 64] (a fiblet fills whole subgroups; lavapipe's 8 lanes
+// each decode 8 points, a 64-wide GPU one point per lane).
+uint32_t defaultRasterLanes(const gpu::VulkanContext& context);
+
+// `raster_lanes`: 8, 16, 32 or 64; 0 = defaultRasterLanes. Throws Error for
+// other values or when a pipeline cannot be created.
+FibletPasses createFibletPasses(const gpu::VulkanContext& context, uint32_t raster_lanes = 0);
 void destroyFibletPasses(const gpu::VulkanContext& context, FibletPasses& passes);
 
 // Every fiblet of the dataset, one workgroup each.

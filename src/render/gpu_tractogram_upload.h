@@ -20,8 +20,8 @@ struct TractogramUpload {
   double upload_seconds = 0;
 };
 
-// Encodes `tractogram` (one thread) with parameters estimated from it
-// (N = 60) and uploads the result. `name` stands
+// Encodes `tractogram` on every core with parameters estimated from it
+// (N = 60; the same records as encodeTractogram) and uploads the result. `name` stands
 // for the file in messages. Throws Error as chooseCodecParams,
 // encodeTractogram and GpuDataset::upload do (e.g. a dataset that does not
 // fit on the device).

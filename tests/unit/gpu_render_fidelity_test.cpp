@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "codec/fiblet_encoder.h"
 #include "gpu_test_context.h"
 #include "io/reader.h"
 #include "phantom/phantom.h"
@@ -80,6 +81,22 @@ TEST_F(GpuRenderFidelity, computePipelineMatchesTheCpuReferenceFromEveryView) {
       EXPECT_GE(double(same_fiber), 0.95 * double(both)) << same_fiber << " of " << both;
     }
   }
+}
+
+TEST_F(GpuRenderFidelity, onTheFlyUploadEncodesInParallelLikeTheSequentialEncoder) {
+  // 700 fibers of ~880 points: three chunks of 2^18 points, so the parts
+  // encoded by different workers are joined.
+  const Tractogram fibers = phantom(700, 9);
+  ASSERT_GT(fibers.pointCount(), size_t(2) << 18);
+  const TractogramUpload upload = uploadTractogram(context(), fibers, "phantom");
+  const EncodedFiblets expected = encodeTractogram(fibers, upload.params);
+  std::vector<uint8_t> records(expected.bytes.size());
+  ASSERT_EQ(upload.dataset.block().fiblet_count, expected.fibletCount());
+  gpu::downloadFromBuffer(context(), upload.dataset.records(), records.data(), records.size());
+  EXPECT_TRUE(records == expected.bytes);
+  std::vector<uint32_t> first(expected.fiberCount() + 1);
+  gpu::downloadFromBuffer(context(), upload.dataset.fiberFirstFiblet(), first.data(), first.size() * 4);
+  for (size_t f = 0; f < expected.fiberCount(); ++f) ASSERT_EQ(first[f], expected.fiber_first_fiblet[f]) << f;
 }
 
 }  // namespace

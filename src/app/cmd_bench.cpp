@@ -1,0 +1,210 @@
+// `fibscope bench [FILE] [--pipeline P] [--culling C] [--compare P[/C],...]
+// [--frames N] [--step DEG] [--size WxH] [--json]`: the fiblets paper's
+// frame benchmark (section 5): 1920x1080, the camera orbiting the
+// tractogram at 1.14 degrees per frame for a full turn (316 frames), GPU
+// timestamps around every pass. Prints mean / median / p95 frame time, the
+// time of each pass, the fraction of fiblets drawn and segments drawn per
+// millisecond; with --compare, several pipelines draw the same frames in one
+// run (frame by frame, in turn) and their ratios to the first are printed.
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "app/commands.h"
+#include "app/render_options.h"
+#include "app/render_scene.h"
+#include "core/error.h"
+#include "render/camera.h"
+#include "render/gpu_frame_renderer.h"
+
+namespace fibscope {
+namespace {
+
+struct BenchOptions {
+  RenderCliOptions render;
+  std::string compare;
+  uint32_t frames = 316;
+  double step_deg = 1.14;
+  double elevation_deg = 0;
+  double distance = 1.0;
+  uint32_t warmup = 2;
+  bool json = false;
+};
+
+struct Variant {
+  std::string label;  // "compute/two-phase"
+  RenderSettings settings;
+  std::vector<double> gpu_ms, wall_ms, drawn_fraction, lod_fraction;
+  std::map<std::string, double> pass_ms_sum;
+  std::vector<std::string> pass_order;
+  uint64_t segments_drawn_sum = 0;
+};
+
+std::vector<Variant> variantsFrom(const BenchOptions& o) {
+  const RenderSettings base = renderSettingsFrom(o.render);
+  std::vector<std::string> specs;
+  if (o.compare.empty()) {
+    specs.push_back(o.render.pipeline + "/" + o.render.culling);
+  } else {
+    size_t start = 0;
+    while (start <= o.compare.size()) {
+      const size_t comma = o.compare.find(',', start);
+      specs.push_back(o.compare.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+      if (comma == std::string::npos) break;
+      start = comma + 1;
+    }
+  }
+  std::vector<Variant> variants;
+  for (const std::string& spec : specs) {
+    Variant v;
+    v.settings = base;
+    const size_t slash = spec.find('/');
+    v.settings.pipeline = parseRenderPipeline(spec.substr(0, slash));
+    if (slash != std::string::npos) v.settings.culling = parseCullingMode(spec.substr(slash + 1));
+    v.label = std::string(renderPipelineName(v.settings.pipeline));
+    if (v.settings.pipeline == RenderPipeline::Compute) v.label += "/" + std::string(cullingModeName(v.settings.culling));
+    variants.push_back(std::move(v));
+  }
+  return variants;
+}
+
+double percentile(std::vector<double> values, double p) {
+  if (values.empty()) return 0;
+  std::sort(values.begin(), values.end());
+  const double rank = p / 100.0 * double(values.size() - 1);
+  const size_t lo = size_t(std::floor(rank)), hi = std::min(lo + 1, values.size() - 1);
+  return values[lo] + (rank - double(lo)) * (values[hi] - values[lo]);
+}
+
+double mean(const std::vector<double>& values) {
+  double sum = 0;
+  for (double v : values) sum += v;
+  return values.empty() ? 0 : sum / double(values.size());
+}
+
+void runBench(const BenchOptions& o) {
+  if (o.frames < 1 || o.frames > 100000) throw Error("--frames: expected 1 to 100000");
+  if (!(std::fabs(o.step_deg) <= 360)) throw Error("--step: expected degrees in [-360, 360]");
+  std::vector<Variant> variants = variantsFrom(o);
+  uint32_t width = 0, height = 0;
+  parseFrameSize(o.render.size, width, height);
+  bool need_points = false;
+  for (const Variant& v : variants) need_points |= v.settings.pipeline != RenderPipeline::Compute;
+
+  auto context = createRenderContext(o.render);
+  SceneOptions scene_options;
+  scene_options.path = o.render.input;
+  scene_options.phantom_streamlines = o.render.phantom_streamlines;
+  scene_options.keep_points = need_points;
+  LoadedScene scene = loadScene(*context, scene_options);
+  const GpuScene gpu_scene{&scene.fiblets};
+
+  // One renderer per variant: two-phase culling keeps the previous frame's
+  // visibility, which must be its own.
+  std::vector<std::unique_ptr<FrameRenderer>> renderers;
+  for (size_t i = 0; i < variants.size(); ++i) renderers.push_back(std::make_unique<FrameRenderer>(*context, width, height));
+
+  const uint32_t total = o.warmup + o.frames;
+  for (uint32_t frame = 0; frame < total; ++frame) {
+    // Warm-up frames run at the first frame's camera.
+    const double azimuth = o.step_deg * double(frame < o.warmup ? 0 : frame - o.warmup);
+    const Camera camera = orbitCamera(scene.bounds, azimuth, o.elevation_deg, width, height, o.distance);
+    for (size_t i = 0; i < variants.size(); ++i) {
+      Variant& v = variants[i];
+      const auto t0 = std::chrono::steady_clock::now();
+      const FrameStats stats = renderers[i]->render(camera, v.settings, gpu_scene);
+      const double wall = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+      if (frame < o.warmup) continue;
+      v.gpu_ms.push_back(stats.gpu_ms);
+      v.wall_ms.push_back(wall);
+      const double total_fiblets = double(std::max<uint64_t>(stats.fiblets_total, 1));
+      v.drawn_fraction.push_back(double(stats.fiblets_drawn) / total_fiblets);
+      v.lod_fraction.push_back(double(stats.fiblets_lod) / total_fiblets);
+      // Segments drawn: every segment for the baselines; for fiblets the
+      // drawn fraction of the dataset's segments (fiblets hold ~N - 1 each).
+      v.segments_drawn_sum += v.settings.pipeline == RenderPipeline::Compute
+                                  ? uint64_t(double(scene.segments) * double(stats.fiblets_drawn) / total_fiblets)
+                                  : scene.segments;
+      for (const PassTiming& p : stats.passes) {
+        if (!v.pass_ms_sum.count(p.name)) v.pass_order.push_back(p.name);
+        v.pass_ms_sum[p.name] += p.ms;
+      }
+    }
+  }
+  checkValidation(*context, o.render);
+
+  nlohmann::json out;
+  out["input"] = scene.name;
+  out["device"] = context->info().name;
+  out["driver"] = context->info().driver_name + " " + context->info().driver_info;
+  out["size"] = {width, height};
+  out["frames"] = o.frames;
+  out["step_deg"] = o.step_deg;
+  out["streamlines"] = scene.streamlines;
+  out["segments"] = scene.segments;
+  out["fiblets"] = scene.fiblets.block().fiblet_count;
+  if (!o.json) {
+    std::printf("%s: %llu streamlines, %llu segments, %u fiblets; %u frames at %.2f deg/frame, %ux%u, %s\n",
+                scene.name.c_str(), static_cast<unsigned long long>(scene.streamlines),
+                static_cast<unsigned long long>(scene.segments), scene.fiblets.block().fiblet_count, o.frames,
+                o.step_deg, width, height, context->info().name.c_str());
+    std::printf("%-20s %10s %10s %10s %10s %9s %9s %14s\n", "pipeline", "mean ms", "median ms", "p95 ms", "wall ms",
+                "drawn", "lod", "segments/ms");
+  }
+  const double base_median = percentile(variants.front().gpu_ms, 50);
+  for (Variant& v : variants) {
+    const double median = percentile(v.gpu_ms, 50);
+    const double gpu_total = std::max(1e-9, mean(v.gpu_ms) * double(v.gpu_ms.size()));
+    const double segments_per_ms = double(v.segments_drawn_sum) / gpu_total;
+    nlohmann::json j;
+    j["pipeline"] = v.label;
+    j["mean_ms"] = mean(v.gpu_ms);
+    j["median_ms"] = median;
+    j["p95_ms"] = percentile(v.gpu_ms, 95);
+    j["wall_mean_ms"] = mean(v.wall_ms);
+    j["fiblets_drawn_fraction"] = mean(v.drawn_fraction);
+    j["fiblets_lod_fraction"] = mean(v.lod_fraction);
+    j["segments_drawn_per_ms"] = segments_per_ms;
+    j["median_ratio_to_first"] = base_median > 0 ? median / base_median : 0.0;
+    for (const std::string& name : v.pass_order) j["pass_mean_ms"][name] = v.pass_ms_sum[name] / double(o.frames);
+    if (!o.json) {
+      std::printf("%-20s %10.3f %10.3f %10.3f %10.3f %8.1f%% %8.1f%% %14.0f", v.label.c_str(), mean(v.gpu_ms), median,
+                  percentile(v.gpu_ms, 95), mean(v.wall_ms), 100 * mean(v.drawn_fraction),
+                  100 * mean(v.lod_fraction), segments_per_ms);
+      if (variants.size() > 1) std::printf("   x%.2f of %s", base_median > 0 ? median / base_median : 0.0,
+                                           variants.front().label.c_str());
+      std::printf("\n    passes:");
+      for (const std::string& name : v.pass_order) std::printf(" %s %.3f", name.c_str(), v.pass_ms_sum[name] / double(o.frames));
+      std::printf(" (mean ms)\n");
+    }
+    out["results"].push_back(j);
+  }
+  if (o.json) std::printf("%s\n", out.dump(2).c_str());
+}
+
+}  // namespace
+
+void addBenchCommand(CLI::App& app) {
+  auto o = std::make_shared<BenchOptions>();
+  CLI::App* cmd = app.add_subcommand("bench", "Frame benchmark: the camera orbits the tractogram (fiblets paper protocol)");
+  addRenderCliOptions(cmd, o->render);
+  cmd->add_option("--compare", o->compare,
+                  "Pipelines drawn on the same frames, e.g. compute/two-phase,compute/none,lines,raw-compute; ratios "
+                  "are to the first");
+  cmd->add_option("--frames", o->frames, "Measured frames")->capture_default_str();
+  cmd->add_option("--step", o->step_deg, "Orbit step per frame, degrees")->capture_default_str();
+  cmd->add_option("--elevation", o->elevation_deg, "Orbit elevation, degrees")->capture_default_str();
+  cmd->add_option("--distance", o->distance, "Camera distance (1 frames the tractogram)")->capture_default_str();
+  cmd->add_option("--warmup", o->warmup, "Unmeasured frames first")->capture_default_str();
+  cmd->add_flag("--json", o->json, "Print the results as JSON");
+  cmd->callback([o] { runBench(*o); });
+}
+
+}  // namespace fibscope

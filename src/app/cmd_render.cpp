@@ -1,0 +1,105 @@
+// `fibscope render [FILE] [--pipeline ...] [--culling ...] [--view V |
+// --camera AZ,EL,DIST] [--size WxH] [--color ...] [--lighting ...] -o PNG`:
+// one frame, headless, to a PNG. Reads (or generates) the tractogram,
+// compresses it to fiblets in memory (a .fbl is uploaded as stored),
+// renders, and writes the image; prints where the time went.
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "app/commands.h"
+#include "app/render_options.h"
+#include "app/render_scene.h"
+#include "core/error.h"
+#include "render/camera.h"
+#include "render/gpu_frame_renderer.h"
+#include "render/reference_raster.h"
+
+namespace fibscope {
+namespace {
+
+struct RenderCommandOptions {
+  RenderCliOptions render;
+  std::string view;
+  std::string camera;
+  std::string output;
+};
+
+using Clock = std::chrono::steady_clock;
+double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+Camera cameraFor(const RenderCommandOptions& o, const Bounds& bounds, uint32_t width, uint32_t height) {
+  if (!o.view.empty()) {
+    if (o.view == "sagittal") return standardView(bounds, StandardView::Sagittal, width, height);
+    if (o.view == "coronal") return standardView(bounds, StandardView::Coronal, width, height);
+    if (o.view == "axial") return standardView(bounds, StandardView::Axial, width, height);
+    throw Error("--view: expected sagittal, coronal or axial, got '" + o.view + "'");
+  }
+  // Default: a three-quarter view from the front left and above, the
+  // tractogram framed.
+  double azimuth = 125, elevation = 20, distance = 1.0;
+  if (!o.camera.empty()) {
+    char rest = 0;
+    if (std::sscanf(o.camera.c_str(), "%lf,%lf,%lf%c", &azimuth, &elevation, &distance, &rest) != 3 ||
+        !(distance > 0.01 && distance < 1000) || !(elevation >= -90 && elevation <= 90))
+      throw Error("--camera: expected AZ,EL,DIST (degrees, degrees in [-90, 90], distance factor > 0.01; 1 frames "
+                  "the tractogram), got '" + o.camera + "'");
+  }
+  return orbitCamera(bounds, azimuth, elevation, width, height, distance);
+}
+
+void runRender(const RenderCommandOptions& o) {
+  const auto start = Clock::now();
+  if (o.output.size() < 5 || o.output.substr(o.output.size() - 4) != ".png")
+    throw Error("-o: the output must be a .png file, got '" + o.output + "'");
+  if (!o.view.empty() && !o.camera.empty()) throw Error("--view and --camera: give one of them");
+  const RenderSettings settings = renderSettingsFrom(o.render);
+  uint32_t width = 0, height = 0;
+  parseFrameSize(o.render.size, width, height);
+
+  auto context = createRenderContext(o.render);
+  SceneOptions scene_options;
+  scene_options.path = o.render.input;
+  scene_options.phantom_streamlines = o.render.phantom_streamlines;
+  scene_options.keep_points = settings.pipeline != RenderPipeline::Compute;
+  LoadedScene scene = loadScene(*context, scene_options);
+
+  const Camera camera = cameraFor(o, scene.bounds, width, height);
+  auto t = Clock::now();
+  FrameStats stats;
+  std::vector<uint8_t> rgba;
+  {
+    FrameRenderer renderer(*context, width, height);
+    stats = renderer.render(camera, settings, GpuScene{&scene.fiblets});
+    rgba = downloadColor(*context, renderer.targets());
+  }
+  const double frame_seconds = secondsSince(t);
+  t = Clock::now();
+  writePngRgba(o.output, width, height, rgba);
+  const double png_seconds = secondsSince(t);
+  checkValidation(*context, o.render);
+  std::printf("%s: %llu streamlines, %llu segments -> %s (%ux%u, %s pipeline, %s culling)\n", scene.name.c_str(),
+              static_cast<unsigned long long>(scene.streamlines), static_cast<unsigned long long>(scene.segments),
+              o.output.c_str(), width, height, std::string(renderPipelineName(settings.pipeline)).c_str(),
+              std::string(cullingModeName(settings.culling)).c_str());
+  std::printf("time: read %.3f s, compress %.3f s, upload %.3f s, frame %.3f s (GPU %.1f ms), png %.3f s, total "
+              "%.3f s\n",
+              scene.read_seconds, scene.encode_seconds, scene.upload_seconds, frame_seconds, stats.gpu_ms,
+              png_seconds, secondsSince(start));
+}
+
+}  // namespace
+
+void addRenderCommand(CLI::App& app) {
+  auto o = std::make_shared<RenderCommandOptions>();
+  CLI::App* cmd = app.add_subcommand("render", "Render one frame of a tractogram (or the built-in phantom) to a PNG");
+  addRenderCliOptions(cmd, o->render);
+  cmd->add_option("--view", o->view, "sagittal | coronal | axial");
+  cmd->add_option("--camera", o->camera, "AZ,EL,DIST: orbit angles in degrees and distance (1 frames the data)");
+  cmd->add_option("-o,--output", o->output, "Output PNG")->required();
+  cmd->callback([o] { runRender(*o); });
+}
+
+}  // namespace fibscope

@@ -1,0 +1,37 @@
+// What `fibscope render` and `fibscope bench` draw: a tractogram file (any
+// readable format; .fbl uploaded as stored, anything else compressed on the
+// fly in memory) or, with no file, the built-in phantom, uploaded to the
+// GPU with the camera box.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "core/tractogram.h"
+#include "gpu/vulkan_context.h"
+#include "render/camera.h"
+#include "render/gpu_dataset.h"
+
+namespace fibscope {
+
+struct SceneOptions {
+  std::string path;                      // empty: the built-in phantom
+  uint64_t phantom_streamlines = 10000;  // built-in phantom size
+  bool keep_points = false;              // keep the raw points (the baselines need them)
+  bool progress = true;                  // progress bars on a terminal
+};
+
+struct LoadedScene {
+  std::string name;      // the file, or "phantom"
+  Tractogram points;     // the raw streamlines when keep_points (for .fbl: as decoded); else empty
+  GpuDataset fiblets;
+  Bounds bounds;
+  uint64_t streamlines = 0, segments = 0;
+  double read_seconds = 0, encode_seconds = 0, upload_seconds = 0;
+};
+
+// Reads, encodes and uploads. Throws Error naming the file for unreadable or
+// malformed input, and for a dataset that does not fit on the device.
+LoadedScene loadScene(const gpu::VulkanContext& context, const SceneOptions& options);
+
+}  // namespace fibscope
