@@ -25,6 +25,7 @@ FrameRenderer::FrameRenderer(const gpu::VulkanContext& context, uint32_t width, 
   try {
     targets_ = createFrameTargets(context, width, height);
     fiblet_passes_ = createFibletPasses(context);
+    shade_pass_ = createShadePass(context, width, height);
     timer_ = gpu::createGpuTimer(context, kMaxPassesPerFrame);
   } catch (...) {
     release();
@@ -36,6 +37,7 @@ FrameRenderer::~FrameRenderer() { release(); }
 
 void FrameRenderer::release() {
   gpu::destroyGpuTimer(context_, timer_);
+  destroyShadePass(context_, shade_pass_);
   destroyFibletPasses(context_, fiblet_passes_);
   destroyFrameTargets(context_, targets_);
 }
@@ -44,6 +46,12 @@ void FrameRenderer::resize(uint32_t width, uint32_t height) {
   if (width == targets_.width && height == targets_.height) return;
   vkDeviceWaitIdle(context_.device());
   GpuFrameTargets fresh = createFrameTargets(context_, width, height);
+  try {
+    resizeShadePass(context_, shade_pass_, width, height);
+  } catch (...) {
+    destroyFrameTargets(context_, fresh);
+    throw;
+  }
   destroyFrameTargets(context_, targets_);
   targets_ = fresh;
 }
@@ -55,6 +63,7 @@ void FrameRenderer::record(VkCommandBuffer cmd, const Camera& camera, const Rend
                 " px, the frame " + std::to_string(targets_.width) + " x " + std::to_string(targets_.height));
   if (!(settings.line_width_px >= kMinLineWidth && settings.line_width_px <= kMaxLineWidth))
     throw Error("render: line width must lie in [1, 4] px, got " + std::to_string(settings.line_width_px));
+  validateShadeSettings(settings);
   if (settings.pipeline == RenderPipeline::Compute && !scene.fiblets)
     throw Error("render: the compute pipeline needs fiblets");
   if (settings.pipeline != RenderPipeline::Compute)
@@ -85,6 +94,8 @@ void FrameRenderer::record(VkCommandBuffer cmd, const Camera& camera, const Rend
   recordFibletResolve(cmd, fiblet_passes_, dataset, targets_);
   gpu::endPass(cmd, timer_);
   computeToCompute(cmd);
+
+  recordShade(cmd, shade_pass_, targets_, settings, &timer_);
 }
 
 FrameStats FrameRenderer::collect() {

@@ -16,6 +16,7 @@
 #include "render/gpu_dataset.h"
 #include "render/gpu_fiblet_passes.h"
 #include "render/gpu_frame_targets.h"
+#include "render/gpu_shade_pass.h"
 #include "render/render_settings.h"
 
 namespace fibscope {
@@ -56,6 +57,7 @@ class FrameRenderer {
   const gpu::VulkanContext& context_;
   GpuFrameTargets targets_;
   FibletPasses fiblet_passes_;
+  ShadePass shade_pass_;
   gpu::GpuTimer timer_;
   FrameStats pending_;
 };

@@ -1,0 +1,61 @@
+// Screen-space ambient occlusion for lines (DESIGN.md section 6, "Shading").
+// Lines have no surface normal, so instead of a normal-oriented hemisphere
+// each covered pixel looks at kSsaoSamples G-buffer neighbours on a disc of
+// radius_px around it (a Vogel spiral, rotated by a per-pixel hash so the
+// pattern's banding becomes noise the blur removes) and counts those of
+// OTHER fibers that lie nearer the camera, as line renderers with depth
+// cues do (e.g. the fiblets paper's fig. 1): a fiber behind or inside a
+// bundle darkens, the front of a bundle does not.
+//   - A neighbour occludes when it is nearer by more than epsilon_mm (fibers
+//     side by side in a bundle do not) and less than range_mm, with a
+//     smooth falloff over the second half of the range: foreground far in
+//     front (another bundle) casts no shadow.
+//   - Samples nearer the centre weigh more (1 at the centre, 0.5 at the rim).
+//   - Neighbours of the same fiber never occlude, so a lone fiber over an
+//     empty background stays exactly 1 however it turns in depth.
+// ao = 1 - strength * (weighted occluders / total weight); 1 where empty.
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_buffer_reference : require
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+
+#include "shared/shade_push.h"
+#include "glsl/shade_common.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;  // kPixelGroupSize
+
+layout(push_constant, std430) uniform Push { SsaoPush pc; };
+
+layout(buffer_reference, std430, buffer_reference_align = 4) buffer AoRef { float values[]; };
+
+const float kGoldenAngle = 2.39996323;
+
+void main() {
+  const uvec2 p = gl_GlobalInvocationID.xy;
+  if (p.x >= pc.width || p.y >= pc.height) return;
+  const uint index = p.y * pc.width + p.x;
+  GBufferRef gbuffer = GBufferRef(pc.gbuffer);
+  const GBufferTexel centre = gbuffer.texels[index];
+  float ao = 1.0;
+  if (centre.fiber != kNoFiberId && pc.radius_px > 0.0 && pc.strength > 0.0) {
+    const CameraBlock cam = CameraRef(pc.camera).camera;
+    const float z = viewDistance(cam, centre.depth);
+    const float rotation = float(shadeHash(p.x * 0x9E3779B1u ^ p.y * 0x85EBCA77u) >> 8) * (6.28318531 / 16777216.0);
+    float occluded = 0.0, total = 0.0;
+    for (uint i = 0u; i < kSsaoSamples; ++i) {
+      const float r = pc.radius_px * sqrt((float(i) + 0.5) / float(kSsaoSamples));
+      const float a = float(i) * kGoldenAngle + rotation;
+      const float weight = 1.0 - 0.5 * r / pc.radius_px;
+      total += weight;
+      const ivec2 q = ivec2(floor(vec2(p) + 0.5 + r * vec2(cos(a), sin(a))));
+      if (q.x < 0 || q.y < 0 || q.x >= int(pc.width) || q.y >= int(pc.height)) continue;
+      const GBufferTexel t = gbuffer.texels[uint(q.y) * pc.width + uint(q.x)];
+      if (t.fiber == kNoFiberId || t.fiber == centre.fiber) continue;
+      const float nearer = z - viewDistance(cam, t.depth);
+      if (nearer > pc.epsilon_mm && nearer < pc.range_mm)
+        occluded += weight * (1.0 - smoothstep(0.5 * pc.range_mm, pc.range_mm, nearer));
+    }
+    ao = 1.0 - pc.strength * occluded / total;
+  }
+  AoRef(pc.ao).values[index] = ao;
+}

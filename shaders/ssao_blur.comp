@@ -1,0 +1,51 @@
+// One direction of the depth-aware separable blur of the SSAO factor
+// (ssao.comp): a 2 * kSsaoBlurRadius + 1 tap Gaussian along (step_x,
+// step_y) over covered pixels whose view depth lies within
+// depth_tolerance_mm of the centre's, so the per-pixel rotation noise is
+// smoothed along and across a bundle without bleeding between fibers far
+// apart in depth or into the background. Run once with (1, 0), once with
+// (0, 1). Empty pixels copy their value (1).
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_buffer_reference : require
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+
+#include "shared/shade_push.h"
+#include "glsl/shade_common.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;  // kPixelGroupSize
+
+layout(push_constant, std430) uniform Push { SsaoBlurPush pc; };
+
+layout(buffer_reference, std430, buffer_reference_align = 4) buffer AoRef { float values[]; };
+
+void main() {
+  const uvec2 p = gl_GlobalInvocationID.xy;
+  if (p.x >= pc.width || p.y >= pc.height) return;
+  const uint index = p.y * pc.width + p.x;
+  GBufferRef gbuffer = GBufferRef(pc.gbuffer);
+  AoRef ao_in = AoRef(pc.ao_in);
+  const GBufferTexel centre = gbuffer.texels[index];
+  float result = ao_in.values[index];
+  if (centre.fiber != kNoFiberId) {
+    const CameraBlock cam = CameraRef(pc.camera).camera;
+    const float z = viewDistance(cam, centre.depth);
+    // sigma = radius / 2: the outermost taps weigh e^-2.
+    const float inv_two_sigma2 = 2.0 / float(kSsaoBlurRadius * kSsaoBlurRadius);
+    float sum = result, total = 1.0;
+    const ivec2 step = ivec2(pc.step_x, pc.step_y);
+    for (int k = -int(kSsaoBlurRadius); k <= int(kSsaoBlurRadius); ++k) {
+      if (k == 0) continue;
+      const ivec2 q = ivec2(p) + k * step;
+      if (q.x < 0 || q.y < 0 || q.x >= int(pc.width) || q.y >= int(pc.height)) continue;
+      const uint qi = uint(q.y) * pc.width + uint(q.x);
+      const GBufferTexel t = gbuffer.texels[qi];
+      if (t.fiber == kNoFiberId || abs(viewDistance(cam, t.depth) - z) > pc.depth_tolerance_mm) continue;
+      const float w = exp(-float(k * k) * inv_two_sigma2);
+      sum += w * ao_in.values[qi];
+      total += w;
+    }
+    result = sum / total;
+  }
+  AoRef(pc.ao_out).values[index] = result;
+}

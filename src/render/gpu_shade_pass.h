@@ -1,0 +1,56 @@
+// The shading passes shared by every pipeline (DESIGN.md section 6,
+// "Shading"): G-buffer + camera block -> the RGBA8 image of the frame
+// targets, with optional screen-space ambient occlusion.
+//   ssao       shaders/ssao.comp       occlusion factor per pixel (scratch buffer)
+//   ssao blur  shaders/ssao_blur.comp  depth-aware blur, x then y
+//   shade      shaders/shade.comp      colour x lighting x occlusion -> RGBA8
+// Formulas and push constants: shaders/shared/shade_push.h.
+#pragma once
+
+#include <vulkan/vulkan.h>
+
+#include <cstdint>
+
+#include "gpu/buffer.h"
+#include "gpu/compute_pipeline.h"
+#include "gpu/gpu_timer.h"
+#include "gpu/vulkan_context.h"
+#include "render/gpu_frame_targets.h"
+#include "render/render_settings.h"
+
+namespace fibscope {
+
+struct ShadePass {
+  gpu::ComputePipeline ssao;       // ssao.comp
+  gpu::ComputePipeline ssao_blur;  // ssao_blur.comp
+  gpu::ComputePipeline shade;      // shade.comp
+  // Occlusion factor per pixel (float): ssao writes ao, the x blur ao_blur,
+  // the y blur ao again, which shade reads.
+  gpu::Buffer ao, ao_blur;
+  uint32_t width = 0, height = 0;
+};
+
+// Pipelines and scratch buffers for a width x height frame. Throws Error
+// when a pipeline cannot be created or memory runs out.
+ShadePass createShadePass(const gpu::VulkanContext& context, uint32_t width, uint32_t height);
+void destroyShadePass(const gpu::VulkanContext& context, ShadePass& pass);
+// New scratch buffers for a new frame size (the device must not be using
+// the old ones). Throws Error as createShadePass; the pass keeps its old
+// buffers then.
+void resizeShadePass(const gpu::VulkanContext& context, ShadePass& pass, uint32_t width, uint32_t height);
+
+// Settings the shading passes reject: Error for an SSAO radius outside
+// [0, 64] px, strength outside [0, 1], a range <= 0 mm, negative lighting
+// coefficients or a shininess outside [1, 256]. Called by recordShade.
+void validateShadeSettings(const RenderSettings& settings);
+
+// Records the shading of `frame` (the camera block and the G-buffer must be
+// written and made visible to compute reads before): the SSAO passes when
+// settings.ssao, then shade, with their own barriers between them and a
+// timestamp pair per pass on `timer` when it is not null ("ssao",
+// "ssao blur", "shade"). The frame must have the pass's size. Throws Error
+// for invalid settings or a size mismatch (nothing recorded then).
+void recordShade(VkCommandBuffer cmd, const ShadePass& pass, const GpuFrameTargets& frame,
+                 const RenderSettings& settings, gpu::GpuTimer* timer);
+
+}  // namespace fibscope
