@@ -128,10 +128,12 @@ void runBench(const BenchOptions& o) {
       v.drawn_fraction.push_back(double(stats.fiblets_drawn) / total_fiblets);
       v.lod_fraction.push_back(double(stats.fiblets_lod) / total_fiblets);
       // Segments drawn: every segment for the baselines; for fiblets the
-      // drawn fraction of the dataset's segments (fiblets hold ~N - 1 each).
-      v.segments_drawn_sum += v.settings.pipeline == RenderPipeline::Compute
-                                  ? uint64_t(double(scene.segments) * double(stats.fiblets_drawn) / total_fiblets)
-                                  : scene.segments;
+      // drawn fraction of the dataset's segments (fiblets hold ~N - 1 each)
+      // plus one per LoD fiblet.
+      v.segments_drawn_sum +=
+          v.settings.pipeline == RenderPipeline::Compute
+              ? uint64_t(double(scene.segments) * double(stats.fiblets_drawn) / total_fiblets) + stats.fiblets_lod
+              : scene.segments;
       for (const PassTiming& p : stats.passes) {
         if (!v.pass_ms_sum.count(p.name)) v.pass_order.push_back(p.name);
         v.pass_ms_sum[p.name] += p.ms;

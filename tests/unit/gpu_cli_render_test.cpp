@@ -1,0 +1,113 @@
+// `fibscope render` and `fibscope bench` as a user meets them: a PNG of the
+// built-in phantom or of a file, a JSON benchmark, one-line errors with exit
+// code 2 for bad options and malformed input (and no PNG left behind).
+// Validation layers on (--validate: any message is an error). Skipped
+// without a Vulkan device.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "io/writer.h"
+#include "test_support.h"
+
+namespace fibscope {
+namespace {
+
+int lineCount(const std::string& s) { return int(std::count(s.begin(), s.end(), '\n')); }
+
+// Width and height from a PNG's IHDR, or 0 x 0 when the file is no PNG.
+std::pair<uint32_t, uint32_t> pngSize(const std::string& path) {
+  const std::string bytes = test::readBytes(path);
+  if (bytes.size() < 24 || bytes.compare(0, 8, "\x89PNG\r\n\x1a\n") != 0 || bytes.compare(12, 4, "IHDR") != 0)
+    return {0, 0};
+  auto be32 = [&](size_t at) {
+    return uint32_t(uint8_t(bytes[at])) << 24 | uint32_t(uint8_t(bytes[at + 1])) << 16 |
+           uint32_t(uint8_t(bytes[at + 2])) << 8 | uint32_t(uint8_t(bytes[at + 3]));
+  };
+  return {be32(16), be32(20)};
+}
+
+class GpuCliRender : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto r = test::runFibscope("gpu-info");
+    if (r.exit_code != 0) GTEST_SKIP() << "no usable Vulkan device: " << r.output;
+  }
+  test::TempDir dir_;
+};
+
+TEST_F(GpuCliRender, renderWithoutFileDrawsThePhantomToAPng) {
+  const std::string png = dir_.file("phantom.png");
+  const auto r = test::runFibscope("render --validate --phantom-streamlines 300 --size 160x120 --view axial -o " + png);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(pngSize(png), std::make_pair(160u, 120u));
+  EXPECT_NE(r.output.find("phantom: 300 streamlines"), std::string::npos) << r.output;
+}
+
+TEST_F(GpuCliRender, renderReadsAFileWithEveryColourAndCamera) {
+  const std::string tck = dir_.file("in.tck");
+  writeTractogram(tck, test::smallTractogram(50, 3), TractogramHeader{});
+  for (const std::string options : {"--color solid --lighting none --no-ssao", "--color fiber --camera 10,30,0.8",
+                                    "--culling none --line-width 3 --background 1,1,1", "--culling frustum"}) {
+    SCOPED_TRACE(options);
+    const std::string png = dir_.file("out.png");
+    const auto r = test::runFibscope("render --validate --size 96x64 " + options + " " + tck + " -o " + png);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_EQ(pngSize(png), std::make_pair(96u, 64u));
+  }
+}
+
+TEST_F(GpuCliRender, badOptionsAreOneLineErrors) {
+  const std::string png = dir_.file("x.png");
+  for (const std::string options :
+       {"--size 0x10", "--size 100", "--pipeline fast", "--culling some", "--color red", "--line-width 9",
+        "--background 2,0,0", "--view top", "--camera 1,2", "--view axial --camera 1,2,1"}) {
+    SCOPED_TRACE(options);
+    const auto r = test::runFibscope("render --phantom-streamlines 10 " + options + " -o " + png);
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_EQ(lineCount(r.output), 1) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(png));
+  }
+  const auto r = test::runFibscope("render --phantom-streamlines 10 -o " + dir_.file("x.jpg"));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find(".png"), std::string::npos) << r.output;
+}
+
+TEST_F(GpuCliRender, malformedInputIsNamedAndLeavesNoPng) {
+  const std::string tck = dir_.file("broken.tck");
+  test::writeBytes(tck, "mrtrix tracks\ndatatype: Float32LE\nfile: . 2000\nEND\n");
+  const std::string png = dir_.file("x.png");
+  const auto r = test::runFibscope("render " + tck + " -o " + png);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_EQ(lineCount(r.output), 1) << r.output;
+  EXPECT_NE(r.output.find(tck), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(png));
+}
+
+TEST_F(GpuCliRender, benchReportsTheOrbitAsJson) {
+  const auto r = test::runFibscope(
+      "bench --validate --json --phantom-streamlines 200 --size 192x128 --frames 4 --warmup 1 "
+      "--compare compute/two-phase,compute/none");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto json = nlohmann::json::parse(r.output.substr(r.output.find('{')));
+  EXPECT_EQ(json["frames"], 4);
+  ASSERT_EQ(json["results"].size(), 2u);
+  for (const auto& result : json["results"]) {
+    EXPECT_GT(result["mean_ms"].get<double>(), 0.0);
+    EXPECT_GE(result["p95_ms"].get<double>(), result["median_ms"].get<double>());
+    const double drawn = result["fiblets_drawn_fraction"].get<double>();
+    const double lod = result["fiblets_lod_fraction"].get<double>();
+    EXPECT_GT(drawn + lod, 0.0) << result.dump();
+    EXPECT_LE(drawn + lod, 1.0) << result.dump();
+    bool raster = false;
+    for (const auto& [name, ms] : result["pass_mean_ms"].items()) raster |= name.rfind("raster", 0) == 0;
+    EXPECT_TRUE(raster) << result.dump();
+  }
+  EXPECT_EQ(json["results"][1]["fiblets_drawn_fraction"].get<double>(), 1.0) << "no culling draws every fiblet";
+}
+
+}  // namespace
+}  // namespace fibscope
