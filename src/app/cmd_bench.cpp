@@ -33,7 +33,7 @@ struct BenchOptions {
   uint32_t frames = 316;
   double step_deg = 1.14;
   double elevation_deg = 0;
-  double distance = 1.0;
+  double distance = 0;  // 0: the closest that frames the box at every azimuth
   uint32_t warmup = 2;
   bool json = false;
 };
@@ -111,11 +111,27 @@ void runBench(const BenchOptions& o) {
   std::vector<std::unique_ptr<FrameRenderer>> renderers;
   for (size_t i = 0; i < variants.size(); ++i) renderers.push_back(std::make_unique<FrameRenderer>(*context, width, height));
 
+  nlohmann::json out;
+  // A constant distance for the whole orbit: the farthest of the snug fits
+  // at 12 azimuths, so the tractogram fills the frame without leaving it.
+  double distance = o.distance;
+  if (distance == 0) {
+    for (int k = 0; k < 12; ++k) {
+      const double az = 30.0 * k;
+      auto make = [&](double f) { return orbitCamera(scene.bounds, az, o.elevation_deg, width, height, f); };
+      const Camera snug = snugCamera(scene.sample, make), sphere = make(1.0);
+      auto dist = [](const Camera& c) {
+        return std::hypot(c.eye[0] - c.target[0], c.eye[1] - c.target[1], c.eye[2] - c.target[2]);
+      };
+      distance = std::max(distance, dist(snug) / dist(sphere));
+    }
+  }
+  out["distance_factor"] = distance;
   const uint32_t total = o.warmup + o.frames;
   for (uint32_t frame = 0; frame < total; ++frame) {
     // Warm-up frames run at the first frame's camera.
     const double azimuth = o.step_deg * double(frame < o.warmup ? 0 : frame - o.warmup);
-    const Camera camera = orbitCamera(scene.bounds, azimuth, o.elevation_deg, width, height, o.distance);
+    const Camera camera = orbitCamera(scene.bounds, azimuth, o.elevation_deg, width, height, distance);
     for (size_t i = 0; i < variants.size(); ++i) {
       Variant& v = variants[i];
       const auto t0 = std::chrono::steady_clock::now();
@@ -142,7 +158,6 @@ void runBench(const BenchOptions& o) {
   }
   checkValidation(*context, o.render);
 
-  nlohmann::json out;
   out["input"] = scene.name;
   out["device"] = context->info().name;
   out["driver"] = context->info().driver_name + " " + context->info().driver_info;
@@ -203,7 +218,7 @@ void addBenchCommand(CLI::App& app) {
   cmd->add_option("--frames", o->frames, "Measured frames")->capture_default_str();
   cmd->add_option("--step", o->step_deg, "Orbit step per frame, degrees")->capture_default_str();
   cmd->add_option("--elevation", o->elevation_deg, "Orbit elevation, degrees")->capture_default_str();
-  cmd->add_option("--distance", o->distance, "Camera distance (1 frames the tractogram)")->capture_default_str();
+  cmd->add_option("--distance", o->distance, "Camera distance factor (1: the bounding sphere fits; 0: as close as frames the tractogram all around)")->capture_default_str();
   cmd->add_option("--warmup", o->warmup, "Unmeasured frames first")->capture_default_str();
   cmd->add_flag("--json", o->json, "Print the results as JSON");
   cmd->callback([o] { runBench(*o); });

@@ -30,23 +30,28 @@ struct RenderCommandOptions {
 using Clock = std::chrono::steady_clock;
 double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-Camera cameraFor(const RenderCommandOptions& o, const Bounds& bounds, uint32_t width, uint32_t height) {
+Camera cameraFor(const RenderCommandOptions& o, const LoadedScene& scene, uint32_t width, uint32_t height) {
+  const Bounds& bounds = scene.bounds;
+  // Views are framed snugly: the tractogram within 90 % of the image.
   if (!o.view.empty()) {
-    if (o.view == "sagittal") return standardView(bounds, StandardView::Sagittal, width, height);
-    if (o.view == "coronal") return standardView(bounds, StandardView::Coronal, width, height);
-    if (o.view == "axial") return standardView(bounds, StandardView::Axial, width, height);
-    throw Error("--view: expected sagittal, coronal or axial, got '" + o.view + "'");
+    StandardView view = StandardView::Sagittal;
+    if (o.view == "coronal") view = StandardView::Coronal;
+    else if (o.view == "axial") view = StandardView::Axial;
+    else if (o.view != "sagittal") throw Error("--view: expected sagittal, coronal or axial, got '" + o.view + "'");
+    return snugCamera(scene.sample, [&](double f) { return standardView(bounds, view, width, height, f); });
   }
   // Default: a three-quarter view from the front left and above, the
-  // tractogram framed.
-  double azimuth = 125, elevation = 20, distance = 1.0;
+  // tractogram framed snugly (distance 0 below).
+  double azimuth = 125, elevation = 20, distance = 0;
   if (!o.camera.empty()) {
     char rest = 0;
     if (std::sscanf(o.camera.c_str(), "%lf,%lf,%lf%c", &azimuth, &elevation, &distance, &rest) != 3 ||
-        !(distance > 0.01 && distance < 1000) || !(elevation >= -90 && elevation <= 90))
-      throw Error("--camera: expected AZ,EL,DIST (degrees, degrees in [-90, 90], distance factor > 0.01; 1 frames "
-                  "the tractogram), got '" + o.camera + "'");
+        !(distance == 0 || (distance > 0.01 && distance < 1000)) || !(elevation >= -90 && elevation <= 90))
+      throw Error("--camera: expected AZ,EL,DIST (degrees, degrees in [-90, 90], distance factor > 0.01 where 1 "
+                  "fits the bounding sphere, or 0 to frame the tractogram snugly), got '" + o.camera + "'");
   }
+  if (distance == 0)
+    return snugCamera(scene.sample, [&](double f) { return orbitCamera(bounds, azimuth, elevation, width, height, f); });
   return orbitCamera(bounds, azimuth, elevation, width, height, distance);
 }
 
@@ -66,7 +71,7 @@ void runRender(const RenderCommandOptions& o) {
   scene_options.keep_points = settings.pipeline != RenderPipeline::Compute;
   LoadedScene scene = loadScene(*context, scene_options);
 
-  const Camera camera = cameraFor(o, scene.bounds, width, height);
+  const Camera camera = cameraFor(o, scene, width, height);
   auto t = Clock::now();
   FrameStats stats;
   std::vector<uint8_t> rgba;
@@ -97,7 +102,7 @@ void addRenderCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("render", "Render one frame of a tractogram (or the built-in phantom) to a PNG");
   addRenderCliOptions(cmd, o->render);
   cmd->add_option("--view", o->view, "sagittal | coronal | axial");
-  cmd->add_option("--camera", o->camera, "AZ,EL,DIST: orbit angles in degrees and distance (1 frames the data)");
+  cmd->add_option("--camera", o->camera, "AZ,EL,DIST: orbit angles in degrees and distance factor (0: framed snugly, 1: the bounding sphere fits)");
   cmd->add_option("-o,--output", o->output, "Output PNG")->required();
   cmd->callback([o] { runRender(*o); });
 }

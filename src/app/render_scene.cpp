@@ -42,6 +42,7 @@ LoadedScene loadScene(const gpu::VulkanContext& context, const SceneOptions& opt
   if (points.streamlineCount() == 0) throw Error(scene.name + ": no streamlines to render");
   scene.read_seconds = secondsSince(t0);
   scene.bounds = tractogramBounds(points);
+  scene.sample = samplePoints(points);
   scene.streamlines = points.streamlineCount();
   scene.segments = segmentCount(points);
 

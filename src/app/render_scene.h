@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "core/tractogram.h"
 #include "gpu/vulkan_context.h"
@@ -26,6 +27,7 @@ struct LoadedScene {
   Tractogram points;     // the raw streamlines when keep_points (for .fbl: as decoded); else empty
   GpuDataset fiblets;
   Bounds bounds;
+  std::vector<Vec3d> sample;  // ~4096 of the points, to frame the view (snugCamera)
   uint64_t streamlines = 0, segments = 0;
   double read_seconds = 0, encode_seconds = 0, upload_seconds = 0;
 };

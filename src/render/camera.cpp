@@ -176,4 +176,38 @@ Camera standardView(const Bounds& bounds, StandardView view, uint32_t width, uin
   fail("camera", "unknown standard view");
 }
 
+Camera snugCamera(std::span<const Vec3d> points, const std::function<Camera(double factor)>& make, double margin) {
+  auto fits = [&](const Camera& camera) {
+    const std::array<double, 16> m = viewProjectionD(camera);
+    for (const Vec3d& p : points) {
+      double c[4];
+      for (int r = 0; r < 4; ++r) c[r] = m[r] * p[0] + m[4 + r] * p[1] + m[8 + r] * p[2] + m[12 + r];
+      if (!(c[2] > 0) || !(std::fabs(c[0]) <= margin * c[3]) || !(std::fabs(c[1]) <= margin * c[3])) return false;
+    }
+    return true;
+  };
+  // The corners' extent on screen shrinks monotonically with the distance:
+  // bisect the factor between a close camera that does not fit and 2 (at 1
+  // the corners may still lie outside the margin).
+  double lo = 0.02, hi = 2.0;
+  if (!fits(make(hi))) return make(hi);
+  for (int i = 0; i < 30; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (fits(make(mid)) ? hi : lo) = mid;
+  }
+  return make(hi);
+}
+
+std::vector<Vec3d> samplePoints(const Tractogram& tractogram, size_t count) {
+  std::vector<Vec3d> sample;
+  const size_t n = tractogram.pointCount();
+  if (n == 0 || count == 0) return sample;
+  const size_t stride = std::max<size_t>(1, n / count);
+  for (size_t i = 0; i < n; i += stride) {
+    const float* p = tractogram.point(i);
+    if (std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2])) sample.push_back({p[0], p[1], p[2]});
+  }
+  return sample;
+}
+
 }  // namespace fibscope

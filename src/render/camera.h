@@ -15,6 +15,9 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
+#include <span>
+#include <vector>
 
 #include "core/tractogram.h"
 #include "shared/camera.h"
@@ -93,5 +96,17 @@ Camera orbitCamera(const Bounds& bounds, double azimuth_deg, double elevation_de
 enum class StandardView { Sagittal, Coronal, Axial };
 Camera standardView(const Bounds& bounds, StandardView view, uint32_t width, uint32_t height,
                     double distance_factor = 1.0, double fov_y_deg = 30.0);
+
+// The closest camera make(factor) (factor in (0, 2], e.g. an orbitCamera's
+// distance factor; 1 fits the box's bounding sphere, which leaves a
+// tractogram much smaller on screen than the window) for which every one of
+// `points` (world mm: a sample of the tractogram's points, or a box's
+// corners) lies in front of the near plane and within `margin` of the image
+// centre in normalised device coordinates (0.9: a 5 % border each side).
+Camera snugCamera(std::span<const Vec3d> points, const std::function<Camera(double factor)>& make,
+                  double margin = 0.9);
+// About `count` points of the tractogram, evenly spaced along its points
+// (for snugCamera).
+std::vector<Vec3d> samplePoints(const Tractogram& tractogram, size_t count = 4096);
 
 }  // namespace fibscope
