@@ -159,6 +159,29 @@ TEST(Camera, FittedCamerasSeeEveryCornerOfTheBoxUnclipped) {
   for (int i = 0; i < 16; ++i) EXPECT_NEAR(a[i], b[i], 1e-5);
 }
 
+TEST(Camera, SnugCameraFramesThePointsWithinTheMarginAndNoCloser) {
+  // Points of an ellipsoid inside a box: the box's bounding sphere leaves
+  // them small on screen; the snug camera brings them to the margin.
+  const Bounds box{{-70, -85, -60}, {70, 85, 60}};
+  std::vector<Vec3d> points;
+  for (int i = 0; i < 400; ++i) {
+    const double u = 0.1 + 3.0 * i / 400, v = 0.37 * i;
+    points.push_back({60 * std::sin(u) * std::cos(v), 75 * std::sin(u) * std::sin(v), 50 * std::cos(u)});
+  }
+  for (const auto& [w, h] : std::vector<std::pair<uint32_t, uint32_t>>{{256, 256}, {1920, 1080}}) {
+    auto make = [&](double f) { return orbitCamera(box, 125, 20, w, h, f); };
+    const Camera camera = snugCamera(points, make, 0.9);
+    double widest = 0;  // the largest |ndc| over the points
+    for (const Vec3d& p : points) {
+      const Projected q = project(camera, p);
+      widest = std::max({widest, std::fabs(2 * q.x / w - 1), std::fabs(2 * q.y / h - 1)});
+      EXPECT_GT(q.depth, 0.0);
+    }
+    EXPECT_LE(widest, 0.9 + 1e-9);
+    EXPECT_GT(widest, 0.89) << "a closer camera would still fit";
+  }
+}
+
 TEST(Camera, InvalidCamerasAreRejected) {
   Camera camera = axisCamera();
   camera.up = {0, 0, 1};  // parallel to the view direction
