@@ -23,6 +23,9 @@ struct GraphicsPipelineDesc {
   VkFormat depth_format = VK_FORMAT_UNDEFINED;  // UNDEFINED: no depth test
   bool primitive_restart = false;               // strips: index 0xffffffff ends one
   uint32_t push_constant_bytes = 0;             // visible to both stages
+  // The line width is dynamic state (vkCmdSetLineWidth before drawing;
+  // widths other than 1 need the wideLines feature).
+  bool dynamic_line_width = false;
 };
 
 struct GraphicsPipeline {

@@ -81,6 +81,15 @@ VulkanContext::VulkanContext(const ContextOptions& options)
   VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
   features.pNext = &features12;
   features.features.shaderInt64 = VK_TRUE;
+  // Optional: the lines baseline draws every streamline with one
+  // vkCmdDrawIndirect (firstInstance = the streamline) and wide lines where
+  // the device has them, and falls back to direct draws and width 1.
+  VkPhysicalDeviceFeatures available{};
+  vkGetPhysicalDeviceFeatures(info_.handle, &available);
+  features.features.wideLines = available.wideLines;
+  features.features.multiDrawIndirect = available.multiDrawIndirect;
+  features.features.drawIndirectFirstInstance = available.drawIndirectFirstInstance;
+  enabled_ = features.features;
 
   const float priority = 1.0f;
   VkDeviceQueueCreateInfo queue_info{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};

@@ -46,6 +46,10 @@ class VulkanContext {
   VkCommandPool commandPool() const { return command_pool_; }
   const VkPhysicalDeviceMemoryProperties& memoryProperties() const { return memory_; }
   const VkPhysicalDeviceLimits& limits() const { return limits_; }
+  // The core features enabled on the device: shaderInt64, and wideLines,
+  // multiDrawIndirect and drawIndirectFirstInstance where the device has
+  // them (the lines baseline falls back without them).
+  const VkPhysicalDeviceFeatures& enabledFeatures() const { return enabled_; }
 
  private:
   void release();
@@ -54,6 +58,7 @@ class VulkanContext {
   DeviceInfo info_;
   VkPhysicalDeviceMemoryProperties memory_{};
   VkPhysicalDeviceLimits limits_{};
+  VkPhysicalDeviceFeatures enabled_{};
   VkDevice device_ = VK_NULL_HANDLE;
   VkQueue queue_ = VK_NULL_HANDLE;
   VkCommandPool command_pool_ = VK_NULL_HANDLE;

@@ -25,6 +25,7 @@ FrameRenderer::FrameRenderer(const gpu::VulkanContext& context, uint32_t width, 
   try {
     targets_ = createFrameTargets(context, width, height);
     fiblet_passes_ = createFibletPasses(context);
+    raw_passes_ = createRawPasses(context);
     shade_pass_ = createShadePass(context, width, height);
     timer_ = gpu::createGpuTimer(context, kMaxPassesPerFrame);
   } catch (...) {
@@ -38,6 +39,8 @@ FrameRenderer::~FrameRenderer() { release(); }
 void FrameRenderer::release() {
   gpu::destroyGpuTimer(context_, timer_);
   destroyShadePass(context_, shade_pass_);
+  destroyLinesPass(context_, lines_pass_);
+  destroyRawPasses(context_, raw_passes_);
   destroyFibletPasses(context_, fiblet_passes_);
   destroyFrameTargets(context_, targets_);
 }
@@ -45,6 +48,7 @@ void FrameRenderer::release() {
 void FrameRenderer::resize(uint32_t width, uint32_t height) {
   if (width == targets_.width && height == targets_.height) return;
   vkDeviceWaitIdle(context_.device());
+  releaseLinesAttachments(context_, lines_pass_);  // made again at the next lines frame
   GpuFrameTargets fresh = createFrameTargets(context_, width, height);
   try {
     resizeShadePass(context_, shade_pass_, width, height);
@@ -66,34 +70,66 @@ void FrameRenderer::record(VkCommandBuffer cmd, const Camera& camera, const Rend
   validateShadeSettings(settings);
   if (settings.pipeline == RenderPipeline::Compute && !scene.fiblets)
     throw Error("render: the compute pipeline needs fiblets");
-  if (settings.pipeline != RenderPipeline::Compute)
-    throw Error("render: pipeline '" + std::string(renderPipelineName(settings.pipeline)) + "' is not built yet");
+  if (settings.pipeline != RenderPipeline::Compute && !scene.raw)
+    throw Error("render: the " + std::string(renderPipelineName(settings.pipeline)) +
+                " pipeline needs the raw tractogram");
+  // Created at the first lines frame: compute-only devices have no
+  // graphics queue and never need it.
+  if (settings.pipeline == RenderPipeline::Lines) {
+    if (lines_pass_.pipeline.pipeline == VK_NULL_HANDLE) lines_pass_ = createLinesPass(context_);
+    ensureLinesAttachments(context_, lines_pass_, targets_.width, targets_.height);
+  }
 
   pending_ = {};
   gpu::resetGpuTimer(cmd, timer_);
 
-  // Frame setup: the camera block and an empty visibility buffer.
+  // Frame setup: the camera block and an empty visibility buffer (the
+  // lines pipeline has its own depth attachment instead).
+  const bool lines = settings.pipeline == RenderPipeline::Lines;
   gpu::beginPass(cmd, timer_, "clear");
   const shader::CameraBlock block = makeCameraBlock(camera, settings.line_width_px);
   vkCmdUpdateBuffer(cmd, targets_.camera.buffer, 0, sizeof(block), &block);
-  vkCmdFillBuffer(cmd, targets_.visibility.buffer, 0, VK_WHOLE_SIZE, 0xFFFFFFFFu);
+  if (!lines) vkCmdFillBuffer(cmd, targets_.visibility.buffer, 0, VK_WHOLE_SIZE, 0xFFFFFFFFu);
   gpu::endPass(cmd, timer_);
   gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                     VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                     lines ? VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT : VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                      VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
 
-  const GpuDataset& dataset = *scene.fiblets;
-  pending_.fiblets_total = dataset.block().fiblet_count;
-  gpu::beginPass(cmd, timer_, "raster");
-  recordFibletRasterAll(cmd, context_, fiblet_passes_, dataset, targets_);
-  gpu::endPass(cmd, timer_);
-  pending_.fiblets_drawn = pending_.fiblets_total;
-  computeToCompute(cmd);
+  if (settings.pipeline == RenderPipeline::Lines) {
+    // Baseline: every streamline as a line strip, no culling.
+    pending_.segments_total = scene.raw->segmentCount();
+    gpu::beginPass(cmd, timer_, "lines");
+    recordLines(cmd, context_, lines_pass_, *scene.raw, targets_, settings.line_width_px);
+    gpu::endPass(cmd, timer_);
+    gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                       VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                       VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+  } else if (settings.pipeline == RenderPipeline::RawCompute) {
+    // Baseline: every raw segment through the compute raster, no culling.
+    pending_.segments_total = scene.raw->segmentCount();
+    gpu::beginPass(cmd, timer_, "raster");
+    recordRawRaster(cmd, context_, raw_passes_, *scene.raw, targets_);
+    gpu::endPass(cmd, timer_);
+    computeToCompute(cmd);
 
-  gpu::beginPass(cmd, timer_, "resolve");
-  recordFibletResolve(cmd, fiblet_passes_, dataset, targets_);
-  gpu::endPass(cmd, timer_);
-  computeToCompute(cmd);
+    gpu::beginPass(cmd, timer_, "resolve");
+    recordRawResolve(cmd, raw_passes_, *scene.raw, targets_);
+    gpu::endPass(cmd, timer_);
+    computeToCompute(cmd);
+  } else {
+    const GpuDataset& dataset = *scene.fiblets;
+    pending_.fiblets_total = dataset.block().fiblet_count;
+    gpu::beginPass(cmd, timer_, "raster");
+    recordFibletRasterAll(cmd, context_, fiblet_passes_, dataset, targets_);
+    gpu::endPass(cmd, timer_);
+    pending_.fiblets_drawn = pending_.fiblets_total;
+    computeToCompute(cmd);
+
+    gpu::beginPass(cmd, timer_, "resolve");
+    recordFibletResolve(cmd, fiblet_passes_, dataset, targets_);
+    gpu::endPass(cmd, timer_);
+    computeToCompute(cmd);
+  }
 
   recordShade(cmd, shade_pass_, targets_, settings, &timer_);
 }

@@ -16,6 +16,9 @@
 #include "render/gpu_dataset.h"
 #include "render/gpu_fiblet_passes.h"
 #include "render/gpu_frame_targets.h"
+#include "render/gpu_lines_pass.h"
+#include "render/gpu_raw_passes.h"
+#include "render/gpu_raw_tractogram.h"
 #include "render/gpu_shade_pass.h"
 #include "render/render_settings.h"
 
@@ -26,6 +29,7 @@ namespace fibscope {
 // input is missing is an Error when the frame is recorded.
 struct GpuScene {
   const GpuDataset* fiblets = nullptr;
+  const GpuRawTractogram* raw = nullptr;  // lines and raw-compute
 };
 
 class FrameRenderer {
@@ -57,6 +61,8 @@ class FrameRenderer {
   const gpu::VulkanContext& context_;
   GpuFrameTargets targets_;
   FibletPasses fiblet_passes_;
+  RawPasses raw_passes_;
+  LinesPass lines_pass_;  // created at the first lines frame
   ShadePass shade_pass_;
   gpu::GpuTimer timer_;
   FrameStats pending_;

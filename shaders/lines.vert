@@ -1,0 +1,40 @@
+// Lines baseline (DESIGN.md section 6; the paper's "basic OpenGL" column):
+// the uncompressed float vertices drawn as line strips, one indirect draw
+// per streamline (firstInstance = the streamline index, firstVertex = 0),
+// vertices pulled through buffer references (no vertex input state).
+// Writes, flat from the provoking (first) vertex of each segment, what the
+// G-buffer texel needs besides the depth.
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_buffer_reference : require
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+
+#include "glsl/raw_tractogram.glsl"
+#include "glsl/tangent.glsl"
+
+layout(push_constant, std430) uniform Push { LinesPush pc; };
+
+layout(location = 0) flat out uint out_fiber;
+layout(location = 1) flat out uint out_segment;
+layout(location = 2) flat out uint out_tangent;
+
+void main() {
+  const RawTractogram t = RawTractogramRef(pc.tractogram).t;
+  const uint fiber = uint(gl_InstanceIndex);
+  const uint vertex = uint(gl_VertexIndex);  // within the streamline: the draw's firstVertex is 0
+  RawOffsetsRef offsets = RawOffsetsRef(t.offsets);
+  const uint64_t first = offsets.values[fiber];
+  const uint64_t count = offsets.values[fiber + 1u] - first;
+  const vec3 p = rawPoint(t, first + uint64_t(vertex));
+  gl_Position = cameraTransformPoint(CameraRef(pc.camera).camera.view_projection, p);
+  // The segment vertex -> vertex + 1; the last vertex of a strip provokes
+  // no segment.
+  uint tangent = 0u;
+  if (uint64_t(vertex) + 1ul < count) {
+    const vec3 d = rawPoint(t, first + uint64_t(vertex) + 1ul) - p;
+    if (dot(d, d) > 0.0) tangent = packTangent(normalize(d));
+  }
+  out_fiber = fiber;
+  out_segment = vertex;
+  out_tangent = tangent;
+}
