@@ -163,9 +163,10 @@ TEST_F(GpuBaselines, rawComputeMatchesTheCpuReferenceFromEveryView) {
       ASSERT_GT(c.covered_b, kSize * kSize / 20) << "the view shows the phantom: " << c.summary();
       const IdAgreement ids = compareIds(texels, reference);
       std::printf(
-          "[ GPU      ] raw-compute %s w%.0f: %s; same fiber %zu, segment %zu, tangent %zu of %zu, depth error %.2g\n",
+          "[ GPU      ] raw-compute %s w%.0f: %s; same fiber %zu, segment %zu, tangent %zu of %zu, depth error %.2g; "
+          "%.2f ms\n",
           view.name, width, c.summary().c_str(), ids.same_fiber, ids.same_segment, ids.tangent_ok, ids.both,
-          ids.max_depth_error);
+          ids.max_depth_error, stats.gpu_ms);
       EXPECT_GE(c.agreement, 0.98) << c.summary();
       EXPECT_LE(c.maxDistance(), 1.0) << c.summary();
       // The same float vertices and the same rule: only float-versus-double
@@ -200,9 +201,9 @@ TEST_F(GpuBaselines, linesCoverTheCpuReferenceToAboutAPixel) {
       const IdAgreement ids = compareIds(texels, reference);
       std::printf(
           "[ GPU      ] lines %s w%.0f: %s; of %zu both: same fiber %zu (segment within 8: %zu, same %zu, depth error "
-          "%.2g), other fiber %zu (%zu of them nearer in the reference)\n",
+          "%.2g), other fiber %zu (%zu of them nearer in the reference); %.2f ms\n",
           view.name, width, c.summary().c_str(), ids.both, ids.same_fiber, ids.segment_within_8, ids.same_segment,
-          ids.max_depth_error, ids.differentFiber(), ids.gpu_farther);
+          ids.max_depth_error, ids.differentFiber(), ids.gpu_farther, stats.gpu_ms);
       // Device line rasterisation (rectangles, or Bresenham's diamonds
       // at width 1 without strictLines) against the capsule rule: a line
       // pixel lies within about a pixel of the reference; the reference
