@@ -46,16 +46,17 @@ struct RenderSettings {
   Lighting lighting = Lighting::IlluminatedLines;
   // Illuminated lines: colour = base * (ambient + diffuse * D) + specular * S^shininess
   // (shaders/shared/shade_push.h).
-  float light_ambient = 0.25f;
-  float light_diffuse = 0.75f;
-  float light_specular = 0.45f;
-  float light_shininess = 24.0f;
+  float light_ambient = 0.2f;
+  float light_diffuse = 0.8f;
+  float light_specular = 0.5f;
+  float light_shininess = 48.0f;
   bool ssao = true;
-  float ssao_radius_px = 8.0f;
-  float ssao_strength = 0.7f;
+  float ssao_radius_px = 10.0f;
+  float ssao_strength = 0.8f;
   // Neighbours nearer than this (view distance, mm) no longer occlude: a
-  // bundle far in front of another casts no shadow on it.
-  float ssao_range_mm = 6.0f;
+  // bundle far in front of another casts no shadow on it, one lying on it
+  // (bundles are about 10 mm thick) does.
+  float ssao_range_mm = 10.0f;
   std::array<float, 3> background = {0.0f, 0.0f, 0.0f};
 };
 
