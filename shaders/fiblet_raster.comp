@@ -84,8 +84,7 @@ void main() {
     if (k == 0u) {
       t = fibletInitialTransform(p0, p1, v);
     } else {
-      const uint code = fibletRecordByte(records, base, fibletCodeByte(k + 1u));
-      t = fibletLocalTransform(directions.directions[code].xyz, v, ds.delta);
+      t = fibletTableTransform(directions, fibletRecordByte(records, base, fibletCodeByte(k + 1u)));
     }
     s = k == first ? t : fibletCompose(s, t);
   }
@@ -110,8 +109,7 @@ void main() {
     if (k == 0u) {
       w = fibletInitialTransform(p0, p1, v);
     } else {
-      const uint code = fibletRecordByte(records, base, fibletCodeByte(k + 1u));
-      w = fibletCompose(w, fibletLocalTransform(directions.directions[code].xyz, v, ds.delta));
+      w = fibletCompose(w, fibletTableTransform(directions, fibletRecordByte(records, base, fibletCodeByte(k + 1u))));
     }
     const vec3 b = fibletToWorld(ds, w.t);  // point k + 1
     rasterSegment(vis, cam, a, b, (uint64_t(fiblet) << kKeySegmentBits) | uint64_t(k));

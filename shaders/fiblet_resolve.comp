@@ -44,10 +44,9 @@ void main() {
       FibletTransform w = fibletInitialTransform(p0, fibletRecordPoint(w0, w1, w2, 1u), v);
       const uint last = min(segment + 1u, count - 1u);
       for (uint k = 2u; k <= last; ++k) {
-        const uint code = fibletRecordByte(records, base, fibletCodeByte(k));
-        const vec4 d = DirectionsRef(ds.directions).directions[code];
         a = w.t;
-        w = fibletCompose(w, fibletLocalTransform(d.xyz, v, ds.delta));
+        w = fibletCompose(w, fibletTableTransform(DirectionsRef(ds.directions),
+                                                  fibletRecordByte(records, base, fibletCodeByte(k))));
       }
       if (segment + 1u < count) {
         if (segment == 0u) a = p0;

@@ -20,6 +20,20 @@ vec3 fibletFirstPoint(WordsRef records, uint base) {
   return fibletRecordPoint(records.words[base], records.words[base + 1u], records.words[base + 2u], 0u);
 }
 
+// L_code from the dataset's table (fiblet_dataset.h: after the 256
+// directions), bit for bit fibletLocalTransform(direction, V, delta).
+FibletTransform fibletTableTransform(DirectionsRef table, uint code) {
+  const vec4 a = table.directions[256u + 3u * code];
+  const vec4 b = table.directions[256u + 3u * code + 1u];
+  const vec4 c = table.directions[256u + 3u * code + 2u];
+  FibletTransform l;
+  l.c0 = a.xyz;
+  l.c1 = vec3(a.w, b.xy);
+  l.c2 = vec3(b.zw, c.x);
+  l.t = c.yzw;
+  return l;
+}
+
 // Normalised -> world mm (FibletDataset: p_mm = translation + mm_per_unit * p_n).
 vec3 fibletToWorld(FibletDataset ds, vec3 p) {
   return vec3(ds.translation_x, ds.translation_y, ds.translation_z) + ds.mm_per_unit * p;

@@ -32,7 +32,10 @@ struct FibletDataset {
   // fiber -> per-fiber colour and length).
   uint64_t fiblet_fiber;
   // vec4[256]: the unit direction of each code in the local frame (w = 0),
-  // buildDirectionTable(alpha).
+  // buildDirectionTable(alpha); then vec4[3 * 256]: each code's local
+  // transform L_c = fibletLocalTransform(direction, V, delta) as 12 floats
+  // (c0, c1, c2, t) in 3 vec4 (fibletTableTransform in
+  // shaders/glsl/fiblet_record.glsl reads it).
   uint64_t directions;
   // uint x (fiber_count + 1): the first fiblet of each fiber, then
   // fiblet_count (fiber f owns fiblets [first[f], first[f + 1])).

@@ -122,7 +122,7 @@ DatasetBytes datasetBytes(uint64_t fibers, uint64_t fiblets, uint32_t record_byt
   DatasetBytes bytes;
   bytes.records = fiblets * record_bytes;
   bytes.fiblet_fiber = fiblets * sizeof(uint32_t);
-  bytes.directions = shader::kFibletCodeCount * sizeof(shader::vec4);
+  bytes.directions = shader::kFibletCodeCount * 4 * sizeof(shader::vec4);  // directions, then L_c as 3 vec4
   bytes.fiber_first_fiblet = (fibers + 1) * sizeof(uint32_t);
   bytes.fiber_length = fibers * sizeof(float);
   bytes.block = sizeof(shader::FibletDataset);
@@ -232,7 +232,20 @@ void GpuDataset::fill(const gpu::VulkanContext& context, const Source& source, c
   block_.v_x = params.v[0];
   block_.v_y = params.v[1];
   block_.v_z = params.v[2];
-  const FibletDirectionTable table = buildDirectionTable(params.alpha);
+  const FibletDirectionTable directions = buildDirectionTable(params.alpha);
+  // The table the shaders read: the 256 directions, then each code's local
+  // transform L_c (fibletLocalTransform: the same arithmetic as the
+  // decoders, so the same bits) as 12 floats in 3 vec4, so decoding a point
+  // costs a table load instead of a frame construction.
+  std::vector<shader::vec4> table(directions.begin(), directions.end());
+  for (const shader::vec4& d : directions) {
+    const shader::FibletTransform l =
+        shader::fibletLocalTransform(shader::vec3(d.x, d.y, d.z), shader::vec3(block_.v_x, block_.v_y, block_.v_z),
+                                     block_.delta);
+    table.push_back({l.c0.x, l.c0.y, l.c0.z, l.c1.x});
+    table.push_back({l.c1.y, l.c1.z, l.c2.x, l.c2.y});
+    table.push_back({l.c2.z, l.t.x, l.t.y, l.t.z});
+  }
 
   if (progress) progress->setTotal(double(bytes.total()));
   gpu::Buffer staging = gpu::createBuffer(

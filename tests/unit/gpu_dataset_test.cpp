@@ -104,8 +104,18 @@ class GpuDatasetUpload : public test::GpuTest {
     EXPECT_TRUE(sameBytes(download<float>(context(), dataset.fiberLength(), fibers), length))
         << "fiber lengths differ from the fiber_length_mm section";
     const FibletDirectionTable table = buildDirectionTable(params.alpha);
-    const auto directions = download<shader::vec4>(context(), dataset.directions(), table.size());
+    const auto directions = download<shader::vec4>(context(), dataset.directions(), 4 * table.size());
     EXPECT_EQ(std::memcmp(directions.data(), table.data(), sizeof table), 0) << "direction table differs";
+    // Then each code's local transform, 12 floats in 3 vec4, bit for bit
+    // the decoders' fibletLocalTransform.
+    for (size_t code = 0; code < table.size(); ++code) {
+      const shader::vec3 d(table[code].x, table[code].y, table[code].z);
+      const shader::FibletTransform l = shader::fibletLocalTransform(d, shader::vec3(block.v_x, block.v_y, block.v_z),
+                                                                     block.delta);
+      const float expected[12] = {l.c0.x, l.c0.y, l.c0.z, l.c1.x, l.c1.y, l.c1.z,
+                                  l.c2.x, l.c2.y, l.c2.z, l.t.x,  l.t.y,  l.t.z};
+      ASSERT_EQ(std::memcmp(&directions[table.size() + 3 * code], expected, sizeof expected), 0) << "L of code " << code;
+    }
     const auto uploaded_block = download<shader::FibletDataset>(context(), dataset.blockBuffer(), 1);
     EXPECT_EQ(std::memcmp(&uploaded_block[0], &block, sizeof block), 0) << "block buffer differs from block()";
 
@@ -117,7 +127,7 @@ class GpuDatasetUpload : public test::GpuTest {
     EXPECT_EQ(wrong, 0u) << "of " << fiblets << " fiblets have the wrong fiber index";
     EXPECT_EQ(first[fibers], fiblets);
 
-    EXPECT_EQ(dataset.bytes(), records.size() + 4 * fiblets + sizeof table + 4 * (fibers + 1) + 4 * fibers +
+    EXPECT_EQ(dataset.bytes(), records.size() + 4 * fiblets + 4 * sizeof table + 4 * (fibers + 1) + 4 * fibers +
                                    sizeof(shader::FibletDataset));
   }
 
