@@ -25,6 +25,7 @@ FrameRenderer::FrameRenderer(const gpu::VulkanContext& context, uint32_t width, 
   try {
     targets_ = createFrameTargets(context, width, height);
     fiblet_passes_ = createFibletPasses(context);
+    cull_passes_ = createCullPasses(context);
     raw_passes_ = createRawPasses(context);
     shade_pass_ = createShadePass(context, width, height);
     timer_ = gpu::createGpuTimer(context, kMaxPassesPerFrame);
@@ -41,6 +42,8 @@ void FrameRenderer::release() {
   destroyShadePass(context_, shade_pass_);
   destroyLinesPass(context_, lines_pass_);
   destroyRawPasses(context_, raw_passes_);
+  destroyCullBuffers(context_, cull_buffers_);
+  destroyCullPasses(context_, cull_passes_);
   destroyFibletPasses(context_, fiblet_passes_);
   destroyFrameTargets(context_, targets_);
 }
@@ -119,10 +122,20 @@ void FrameRenderer::record(VkCommandBuffer cmd, const Camera& camera, const Rend
   } else {
     const GpuDataset& dataset = *scene.fiblets;
     pending_.fiblets_total = dataset.block().fiblet_count;
-    gpu::beginPass(cmd, timer_, "raster");
-    recordFibletRasterAll(cmd, context_, fiblet_passes_, dataset, targets_);
-    gpu::endPass(cmd, timer_);
-    pending_.fiblets_drawn = pending_.fiblets_total;
+    cull_stats_pending_ = settings.culling != CullingMode::None && pending_.fiblets_total > 0;
+    if (cull_stats_pending_) {
+      // Cull passes, both rasters (and the pyramid and second phase for
+      // TwoPhase); fiblets_drawn and fiblets_lod come from collect().
+      prepareCullBuffers(context_, cull_buffers_, dataset.block().fiblet_count, targets_.width, targets_.height);
+      recordCulledRaster(cmd, context_, cull_passes_, fiblet_passes_, dataset, targets_, cull_buffers_,
+                         CullFrame{settings.culling, settings.lod_pixels, cullFocalPixels(camera)}, timer_);
+    } else {
+      gpu::beginPass(cmd, timer_, "raster");
+      recordFibletRasterAll(cmd, context_, fiblet_passes_, dataset, targets_);
+      gpu::endPass(cmd, timer_);
+      pending_.fiblets_drawn = pending_.fiblets_total;
+      cull_buffers_.history_valid = false;  // two-phase history skips this frame
+    }
     computeToCompute(cmd);
 
     gpu::beginPass(cmd, timer_, "resolve");
@@ -136,6 +149,11 @@ void FrameRenderer::record(VkCommandBuffer cmd, const Camera& camera, const Rend
 
 FrameStats FrameRenderer::collect() {
   FrameStats stats = pending_;
+  if (cull_stats_pending_) {
+    const CullStats cull = readCullStats(context_, cull_buffers_);
+    stats.fiblets_drawn = cull.full();
+    stats.fiblets_lod = cull.lod();
+  }
   for (const gpu::PassTime& t : gpu::readGpuTimer(context_, timer_)) {
     stats.passes.push_back({t.name, t.ms});
     stats.gpu_ms += t.ms;

@@ -13,6 +13,7 @@
 #include "gpu/gpu_timer.h"
 #include "gpu/vulkan_context.h"
 #include "render/camera.h"
+#include "render/gpu_cull_passes.h"
 #include "render/gpu_dataset.h"
 #include "render/gpu_fiblet_passes.h"
 #include "render/gpu_frame_targets.h"
@@ -61,6 +62,9 @@ class FrameRenderer {
   const gpu::VulkanContext& context_;
   GpuFrameTargets targets_;
   FibletPasses fiblet_passes_;
+  CullPasses cull_passes_;
+  CullBuffers cull_buffers_;  // lists, pyramid and the two-phase visible bits (kept across frames)
+  bool cull_stats_pending_ = false;  // the last frame was culled: collect() reads its counts
   RawPasses raw_passes_;
   LinesPass lines_pass_;  // created at the first lines frame
   ShadePass shade_pass_;

@@ -1,0 +1,194 @@
+// Cull (DESIGN.md section 6, step 1): one invocation per fiblet. The
+// fiblet's bounding sphere is tested against the frustum dilated by the line
+// width (paper eq. 5) and, in phase 2 of two-phase culling, against the
+// max-depth pyramid of what phase 1 drew; fiblets smaller on screen than
+// lod_pixels go to the LoD list (drawn as one segment), the others to the
+// full list. Modes and the argument for conservativeness: shared/cull_push.h.
+//
+// Bounding sphere: centre = the first point p0. The decoder places point 1
+// as stored and every later point delta from the previous one (a rotation of
+// a unit direction), so point k lies within |p1 - p0| + (k - 1) * delta of
+// p0; the joining segment ends at the next fiblet's first point, read
+// exactly. The radius is the larger of the two bounds (not N * delta: the
+// stored p1 need not be delta from p0, and a short fiblet gets a small
+// sphere), with kCullRadiusSlack for rounding.
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_buffer_reference : require
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+
+#include "shared/cull_push.h"
+#include "glsl/fiblet_record.glsl"
+
+layout(local_size_x = 64) in;  // kCullGroupSize
+
+layout(push_constant, std430) uniform Push { FibletCullPush pc; };
+
+layout(buffer_reference, std430, buffer_reference_align = 4) buffer BitsRef { uint words[]; };
+layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer PyramidRef { float depths[]; };
+
+// Appends are aggregated per workgroup: one global atomicAdd per list per
+// group (no subgroup operations needed). 64 fiblets per group own exactly
+// two words of the visible bits, so phase 2 rewrites them without atomics.
+shared uint s_count[2];
+shared uint s_base[2];
+shared uint s_visible[2];
+
+// Row i of the view-projection matrix (stored as columns).
+vec4 matrixRow(CameraBlock cam, int i) {
+  return vec4(cam.view_projection[0][i], cam.view_projection[1][i], cam.view_projection[2][i],
+              cam.view_projection[3][i]);
+}
+
+// False for a fiblet that draws nothing (a single point ending its fiber,
+// or a record the raster would refuse).
+bool fibletSphere(FibletDataset ds, uint fiblet, out vec3 centre, out float radius) {
+  WordsRef records = WordsRef(ds.records);
+  const uint n = ds.points_per_fiblet;
+  const uint base = fiblet * ds.record_words;
+  const uint flags = fibletRecordByte(records, base, fibletFlagsByte(n));
+  const uint count = fibletCount(flags);
+  centre = vec3(0.0);
+  radius = 0.0;
+  if (count < 1u || count > n) return false;
+  const uint w0 = records.words[base], w1 = records.words[base + 1u], w2 = records.words[base + 2u];
+  const vec3 p0 = fibletRecordPoint(w0, w1, w2, 0u);
+  const bool joins = (flags & kFibletFlagEnds) == 0u && fiblet + 1u < ds.fiblet_count;
+  if (count < 2u && !joins) return false;
+  float r = 0.0;
+  if (count >= 2u) r = length(fibletRecordPoint(w0, w1, w2, 1u) - p0) + float(count - 2u) * ds.delta;
+  if (joins) r = max(r, length(fibletFirstPoint(records, base + ds.record_words) - p0));
+  centre = fibletToWorld(ds, p0);
+  radius = r * ds.mm_per_unit * (1.0 + kCullRadiusSlack);
+  return true;
+}
+
+bool sphereOutside(vec4 plane, vec3 c, float r) { return dot(plane.xyz, c) + plane.w < -r * length(plane.xyz); }
+
+// The frustum dilated by half the line width plus kCullPixelSlack pixels on
+// each side: a sphere entirely outside it cannot bring a pixel centre within
+// half the line width of its projection. Near and far are not dilated (the
+// raster cuts at the near plane and drops depths beyond the far plane).
+bool sphereInFrustum(CameraBlock cam, vec3 c, float r) {
+  const vec4 r0 = matrixRow(cam, 0), r1 = matrixRow(cam, 1), r2 = matrixRow(cam, 2), r3 = matrixRow(cam, 3);
+  const float margin = 0.5 * cam.viewport.z + kCullPixelSlack;
+  // x_w >= -margin  <=>  x_clip >= -w * (1 + 2 margin / width); likewise the others.
+  const float kx = 1.0 + 2.0 * margin / cam.viewport.x;
+  const float ky = 1.0 + 2.0 * margin / cam.viewport.y;
+  return !(sphereOutside(r3 * kx + r0, c, r) || sphereOutside(r3 * kx - r0, c, r) ||
+           sphereOutside(r3 * ky + r1, c, r) || sphereOutside(r3 * ky - r1, c, r) || sphereOutside(r2, c, r) ||
+           sphereOutside(r3 - r2, c, r));
+}
+
+// Far-view LoD: the sphere's projected diameter, measured at its nearest
+// view distance, below lod_pixels.
+bool sphereIsSmall(CameraBlock cam, vec3 c, float r) {
+  if (!(pc.lod_pixels > 0.0)) return false;
+  const vec4 r3 = matrixRow(cam, 3);  // w_clip = view distance along the axis
+  const float nearest = dot(r3.xyz, c) + r3.w - r;
+  if (!(nearest > cam.depth_range.x)) return false;
+  return 2.0 * r * pc.focal_px < pc.lod_pixels * nearest;
+}
+
+// Phase 2: true when every pixel the fiblet could cover already holds a
+// depth nearer than the sphere's nearest depth. The sphere is enclosed in
+// the cube aligned with the view axes; its eight corners bound the sphere's
+// screen rectangle (perspective maps the cube to the hull of the projected
+// corners) and its nearest depth (depth grows with view distance, which is
+// linear, so its minimum over the cube is at a corner). A cube reaching
+// past the near plane is never occluded.
+bool sphereOccluded(CameraBlock cam, vec3 c, float r) {
+  const vec4 centre = cameraTransformPoint(cam.view_projection, c);
+  // View axes in world space (rows of the view rotation), then to clip.
+  vec4 axes[3];
+  for (int i = 0; i < 3; ++i) {
+    const vec3 e = vec3(cam.view[0][i], cam.view[1][i], cam.view[2][i]);
+    axes[i] = r * (cam.view_projection[0] * e.x + cam.view_projection[1] * e.y + cam.view_projection[2] * e.z);
+  }
+  vec2 lo = vec2(1e30), hi = vec2(-1e30);
+  float nearest = 1e30;
+  for (int k = 0; k < 8; ++k) {
+    const vec4 q = centre + ((k & 1) != 0 ? axes[0] : -axes[0]) + ((k & 2) != 0 ? axes[1] : -axes[1]) +
+                   ((k & 4) != 0 ? axes[2] : -axes[2]);
+    if (!(q.z > 0.0) || !(q.w > 0.0)) return false;
+    const vec3 ndc = q.xyz / q.w;
+    lo = min(lo, ndc.xy);
+    hi = max(hi, ndc.xy);
+    nearest = min(nearest, ndc.z);
+  }
+  const vec2 size = cam.viewport.xy;
+  const float margin = 0.5 * cam.viewport.z + kCullPixelSlack;
+  // Pixels whose centre px + 0.5 lies within margin of [lo, hi] in window
+  // coordinates, clamped in float before converting.
+  const vec2 first = max(ceil((lo + 1.0) * 0.5 * size - margin - 0.5), vec2(0.0));
+  const vec2 last = min(floor((hi + 1.0) * 0.5 * size + margin - 0.5), size - 1.0);
+  if (first.x > last.x || first.y > last.y) return true;  // no pixel centre at all
+  const uvec2 p0 = uvec2(first), p1 = uvec2(last);
+  const uint width = uint(size.x), height = uint(size.y);
+  // The finest level at which the rectangle spans at most 2 x 2 texels; a
+  // level-L texel (x, y) is the max over the level-0 pixels (x << L .. ,
+  // y << L ..), so texels p0 >> L .. p1 >> L cover the rectangle.
+  const uint levels = pyramidLevelCount(width, height);
+  uint level = 0u;
+  while (level + 1u < levels && ((p1.x >> level) - (p0.x >> level) > 1u || (p1.y >> level) - (p0.y >> level) > 1u))
+    ++level;
+  const uint level_width = pyramidLevelSize(width, level);
+  const uint offset = pyramidLevelOffset(width, height, level);
+  PyramidRef pyramid = PyramidRef(pc.pyramid);
+  float farthest = 0.0;
+  for (uint y = p0.y >> level; y <= p1.y >> level; ++y)
+    for (uint x = p0.x >> level; x <= p1.x >> level; ++x)
+      farthest = max(farthest, pyramid.depths[offset + y * level_width + x]);
+  return farthest < nearest - kCullDepthSlack;
+}
+
+void main() {
+  const uint local = gl_LocalInvocationIndex;
+  if (local < 2u) {
+    s_count[local] = 0u;
+    s_visible[local] = 0u;
+  }
+  barrier();
+
+  const FibletDataset ds = DatasetRef(pc.dataset).ds;
+  const uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
+  const uint fiblet = group * 64u + local;
+  BitsRef bits = BitsRef(pc.visible);
+  int target = -1;  // 0: full list, 1: LoD list
+  bool visible = false;
+  vec3 c;
+  float r;
+  if (fiblet < ds.fiblet_count && fibletSphere(ds, fiblet, c, r)) {
+    const CameraBlock cam = CameraRef(pc.camera).camera;
+    if (sphereInFrustum(cam, c, r)) {
+      bool draw = true;
+      if (pc.mode != kCullFrustum) {
+        const bool was_visible = (bits.words[fiblet >> 5u] & (1u << (fiblet & 31u))) != 0u;
+        if (pc.mode == kCullPhase1) {
+          draw = was_visible;
+        } else {
+          visible = !sphereOccluded(cam, c, r);
+          draw = visible && !was_visible;  // phase 1 drew the others
+        }
+      }
+      if (draw) target = sphereIsSmall(cam, c, r) ? 1 : 0;
+    }
+  }
+  uint slot = 0u;
+  if (target >= 0) slot = atomicAdd(s_count[target], 1u);
+  if (visible) atomicOr(s_visible[local >> 5u], 1u << (local & 31u));
+  barrier();
+  if (local < 2u && s_count[local] > 0u) {
+    FibletListRef list = FibletListRef(local == 0u ? pc.list : pc.lod_list);
+    s_base[local] = atomicAdd(list.header.count, s_count[local]);
+  }
+  // The bit words are read above (by this group only) before they are
+  // rewritten here, after the barrier.
+  if (pc.mode == kCullPhase2 && local < 2u && group * 2u + local < (ds.fiblet_count + 31u) / 32u)
+    bits.words[group * 2u + local] = s_visible[local];
+  barrier();
+  if (target >= 0) {
+    FibletListRef list = FibletListRef(target == 0 ? pc.list : pc.lod_list);
+    list.fiblets[s_base[target] + slot] = fiblet;
+  }
+}

@@ -1,0 +1,132 @@
+// Push constants and shared arithmetic of the cull passes of the compute
+// pipeline (DESIGN.md section 6, step 1): fiblet_cull.comp,
+// fiblet_list_finalize.comp, depth_pyramid.comp and fiblet_lod_raster.comp.
+//
+// Two-phase occlusion culling (conservative; no visible fiblet is culled):
+//   phase 1  fiblets visible last frame and inside the dilated frustum are
+//            drawn;
+//   pyramid  a max-depth mip chain of the visibility buffer after phase 1;
+//   phase 2  every fiblet inside the frustum is tested against the pyramid
+//            (its bounding sphere's nearest depth against the farthest depth
+//            over its screen rectangle), its "visible" bit is rewritten, and
+//            those not drawn in phase 1 and not occluded are drawn.
+// A fiblet culled in phase 2 is behind depths already in the visibility
+// buffer at every pixel it could cover, and the buffer only gets nearer, so
+// its keys would lose every atomicMin: the final visibility buffer is the
+// one drawing every fiblet gives, bit for bit.
+#ifndef FIBSCOPE_SHADERS_SHARED_CULL_PUSH_H
+#define FIBSCOPE_SHADERS_SHARED_CULL_PUSH_H
+
+#include "shared/glsl_cpp.h"
+
+#ifdef __cplusplus
+#define CULL_CONST inline constexpr
+#else
+#define CULL_CONST const
+#endif
+
+SHADER_NAMESPACE_BEGIN
+
+// FibletCullPush::mode. A second occlusion mode (the paper's re-projected
+// coverage buffer, section 3.4.1) would be one more value testing a
+// different buffer in place of the pyramid.
+CULL_CONST uint kCullFrustum = 0u;  // dilated frustum + LoD, no occlusion (CullingMode::Frustum)
+CULL_CONST uint kCullPhase1 = 1u;   // ... restricted to fiblets whose visible bit is set
+CULL_CONST uint kCullPhase2 = 2u;   // ... + pyramid test, rewrites the visible bits, skips phase-1 fiblets
+
+// The largest pyramid: 16384 px per side (createFrameTargets' limit) has 15
+// levels.
+CULL_CONST uint kPyramidMaxLevels = 16u;
+
+// Slack of the conservative tests, on top of exact bounds: the bounding
+// sphere's radius is scaled by (1 + kCullRadiusSlack); screen rectangles
+// and the dilated frustum get kCullPixelSlack extra pixels on every side;
+// an occluder must be kCullDepthSlack nearer than the sphere's nearest
+// depth. They absorb the float rounding by which the raster's projection of
+// a point can differ from the cull pass's.
+CULL_CONST float kCullRadiusSlack = 1.0e-3f;
+CULL_CONST float kCullPixelSlack = 1.0f;
+CULL_CONST float kCullDepthSlack = 1.0e-5f;
+
+// fiblet_cull.comp: one invocation per fiblet (kCullGroupSize per group).
+struct FibletCullPush {
+  uint64_t dataset;   // FibletDataset block
+  uint64_t camera;    // CameraBlock
+  uint64_t list;      // FibletList: fiblets drawn at full detail
+  uint64_t lod_list;  // FibletList: fiblets drawn as one segment (LoD)
+  uint64_t visible;   // uint per 32 fiblets: bit set = visible last frame (kCullPhase1/2)
+  uint64_t pyramid;   // float, every level of the max-depth pyramid (kCullPhase2)
+  uint mode;          // kCull*
+  float lod_pixels;   // LoD below this projected diameter in px; 0: off
+  float focal_px;     // projection scale in px: |P[1][1]| * height / 2
+  uint pad;
+};
+
+// fiblet_list_finalize.comp: one invocation turns a list's count into its
+// indirect dispatch size.
+struct FibletListFinalizePush {
+  uint64_t list;
+  uint items_per_group;  // 1: the fiblet raster (a workgroup per fiblet); 64: the LoD raster
+  uint max_groups_x;     // maxComputeWorkGroupCount[0]
+};
+
+// depth_pyramid.comp: one dispatch per level.
+struct DepthPyramidPush {
+  uint64_t visibility;  // level 0 reads the visibility keys
+  uint64_t pyramid;
+  uint width;  // level 0 = the frame size
+  uint height;
+  uint level;
+  uint pad;
+};
+
+// fiblet_lod_raster.comp: one invocation per LoD fiblet.
+struct FibletLodRasterPush {
+  uint64_t dataset;
+  uint64_t camera;
+  uint64_t visibility;
+  uint64_t list;
+};
+
+// Size of pyramid level `level` of a width x height frame: level 0 is the
+// frame, each next level ceil(previous / 2), down to 1 x 1.
+SHADER_FN uint pyramidLevelSize(uint size, uint level) {
+  uint s = size;
+  for (uint i = 0u; i < level; ++i) s = (s + 1u) >> 1u;
+  return s;
+}
+// Levels down to 1 x 1 inclusive.
+SHADER_FN uint pyramidLevelCount(uint width, uint height) {
+  uint levels = 1u;
+  uint w = width, h = height;
+  while (w > 1u || h > 1u) {
+    w = (w + 1u) >> 1u;
+    h = (h + 1u) >> 1u;
+    ++levels;
+  }
+  return levels;
+}
+// Float offset of level `level` in the pyramid buffer (levels stored one
+// after the other, row-major, top row first); level = levels gives the
+// total size.
+SHADER_FN uint pyramidLevelOffset(uint width, uint height, uint level) {
+  uint offset = 0u;
+  uint w = width, h = height;
+  for (uint i = 0u; i < level; ++i) {
+    offset += w * h;
+    w = (w + 1u) >> 1u;
+    h = (h + 1u) >> 1u;
+  }
+  return offset;
+}
+
+SHADER_NAMESPACE_END
+
+#ifdef __cplusplus
+static_assert(sizeof(fibscope::shader::FibletCullPush) == 64, "");
+static_assert(sizeof(fibscope::shader::FibletListFinalizePush) == 16, "");
+static_assert(sizeof(fibscope::shader::DepthPyramidPush) == 32, "");
+static_assert(sizeof(fibscope::shader::FibletLodRasterPush) == 32, "");
+#endif
+
+#endif  // FIBSCOPE_SHADERS_SHARED_CULL_PUSH_H
