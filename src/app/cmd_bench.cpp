@@ -102,9 +102,9 @@ void runBench(const BenchOptions& o) {
   SceneOptions scene_options;
   scene_options.path = o.render.input;
   scene_options.phantom_streamlines = o.render.phantom_streamlines;
-  scene_options.keep_points = need_points;
+  scene_options.upload_raw = need_points;
   LoadedScene scene = loadScene(*context, scene_options);
-  const GpuScene gpu_scene{&scene.fiblets};
+  const GpuScene gpu_scene = scene.gpuScene();
 
   // One renderer per variant: two-phase culling keeps the previous frame's
   // visibility, which must be its own.
@@ -186,15 +186,20 @@ void runBench(const BenchOptions& o) {
     j["median_ms"] = median;
     j["p95_ms"] = percentile(v.gpu_ms, 95);
     j["wall_mean_ms"] = mean(v.wall_ms);
-    j["fiblets_drawn_fraction"] = mean(v.drawn_fraction);
-    j["fiblets_lod_fraction"] = mean(v.lod_fraction);
+    const bool fiblets = v.settings.pipeline == RenderPipeline::Compute;  // the baselines draw every segment
+    if (fiblets) {
+      j["fiblets_drawn_fraction"] = mean(v.drawn_fraction);
+      j["fiblets_lod_fraction"] = mean(v.lod_fraction);
+    }
     j["segments_drawn_per_ms"] = segments_per_ms;
     j["median_ratio_to_first"] = base_median > 0 ? median / base_median : 0.0;
     for (const std::string& name : v.pass_order) j["pass_mean_ms"][name] = v.pass_ms_sum[name] / double(o.frames);
     if (!o.json) {
-      std::printf("%-20s %10.3f %10.3f %10.3f %10.3f %8.1f%% %8.1f%% %14.0f", v.label.c_str(), mean(v.gpu_ms), median,
-                  percentile(v.gpu_ms, 95), mean(v.wall_ms), 100 * mean(v.drawn_fraction),
-                  100 * mean(v.lod_fraction), segments_per_ms);
+      std::printf("%-20s %10.3f %10.3f %10.3f %10.3f", v.label.c_str(), mean(v.gpu_ms), median,
+                  percentile(v.gpu_ms, 95), mean(v.wall_ms));
+      if (fiblets) std::printf(" %8.1f%% %8.1f%%", 100 * mean(v.drawn_fraction), 100 * mean(v.lod_fraction));
+      else std::printf(" %9s %9s", "-", "-");
+      std::printf(" %14.0f", segments_per_ms);
       if (variants.size() > 1) std::printf("   x%.2f of %s", base_median > 0 ? median / base_median : 0.0,
                                            variants.front().label.c_str());
       std::printf("\n    passes:");

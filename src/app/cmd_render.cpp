@@ -68,7 +68,7 @@ void runRender(const RenderCommandOptions& o) {
   SceneOptions scene_options;
   scene_options.path = o.render.input;
   scene_options.phantom_streamlines = o.render.phantom_streamlines;
-  scene_options.keep_points = settings.pipeline != RenderPipeline::Compute;
+  scene_options.upload_raw = settings.pipeline != RenderPipeline::Compute;
   LoadedScene scene = loadScene(*context, scene_options);
 
   const Camera camera = cameraFor(o, scene, width, height);
@@ -77,7 +77,7 @@ void runRender(const RenderCommandOptions& o) {
   std::vector<uint8_t> rgba;
   {
     FrameRenderer renderer(*context, width, height);
-    stats = renderer.render(camera, settings, GpuScene{&scene.fiblets});
+    stats = renderer.render(camera, settings, scene.gpuScene());
     rgba = downloadColor(*context, renderer.targets());
   }
   const double frame_seconds = secondsSince(t);

@@ -59,7 +59,12 @@ LoadedScene loadScene(const gpu::VulkanContext& context, const SceneOptions& opt
     scene.encode_seconds = upload.encode_seconds;
     scene.upload_seconds = upload.upload_seconds;
   }
-  if (options.keep_points) scene.points = std::move(points);
+  if (options.upload_raw) {
+    t0 = Clock::now();
+    scene.raw = GpuRawTractogram::upload(context, points, scene.name);
+    scene.has_raw = true;
+    scene.upload_seconds += secondsSince(t0);
+  }
   return scene;
 }
 

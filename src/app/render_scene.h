@@ -12,24 +12,30 @@
 #include "gpu/vulkan_context.h"
 #include "render/camera.h"
 #include "render/gpu_dataset.h"
+#include "render/gpu_frame_renderer.h"
+#include "render/gpu_raw_tractogram.h"
 
 namespace fibscope {
 
 struct SceneOptions {
   std::string path;                      // empty: the built-in phantom
   uint64_t phantom_streamlines = 10000;  // built-in phantom size
-  bool keep_points = false;              // keep the raw points (the baselines need them)
+  bool upload_raw = false;               // also upload the raw vertices (the baselines draw them)
   bool progress = true;                  // progress bars on a terminal
 };
 
 struct LoadedScene {
   std::string name;      // the file, or "phantom"
-  Tractogram points;     // the raw streamlines when keep_points (for .fbl: as decoded); else empty
   GpuDataset fiblets;
+  GpuRawTractogram raw;  // with upload_raw (for .fbl: the decoded points); else empty
+  bool has_raw = false;
   Bounds bounds;
   std::vector<Vec3d> sample;  // ~4096 of the points, to frame the view (snugCamera)
   uint64_t streamlines = 0, segments = 0;
   double read_seconds = 0, encode_seconds = 0, upload_seconds = 0;
+
+  // What a frame of this scene draws.
+  GpuScene gpuScene() const { return GpuScene{&fiblets, has_raw ? &raw : nullptr}; }
 };
 
 // Reads, encodes and uploads. Throws Error naming the file for unreadable or

@@ -51,7 +51,8 @@ TEST_F(GpuCliRender, renderReadsAFileWithEveryColourAndCamera) {
   const std::string tck = dir_.file("in.tck");
   writeTractogram(tck, test::smallTractogram(50, 3), TractogramHeader{});
   for (const std::string options : {"--color solid --lighting none --no-ssao", "--color fiber --camera 10,30,0.8",
-                                    "--culling none --line-width 3 --background 1,1,1", "--culling frustum"}) {
+                                    "--culling none --line-width 3 --background 1,1,1", "--culling frustum",
+                                    "--pipeline lines", "--pipeline raw-compute --view coronal"}) {
     SCOPED_TRACE(options);
     const std::string png = dir_.file("out.png");
     const auto r = test::runFibscope("render --validate --size 96x64 " + options + " " + tck + " -o " + png);
@@ -90,18 +91,26 @@ TEST_F(GpuCliRender, malformedInputIsNamedAndLeavesNoPng) {
 TEST_F(GpuCliRender, benchReportsTheOrbitAsJson) {
   const auto r = test::runFibscope(
       "bench --validate --json --phantom-streamlines 200 --size 192x128 --frames 4 --warmup 1 "
-      "--compare compute/two-phase,compute/none");
+      "--compare compute/two-phase,compute/none,lines,raw-compute");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto json = nlohmann::json::parse(r.output.substr(r.output.find('{')));
   EXPECT_EQ(json["frames"], 4);
-  ASSERT_EQ(json["results"].size(), 2u);
+  ASSERT_EQ(json["results"].size(), 4u);
   for (const auto& result : json["results"]) {
     EXPECT_GT(result["mean_ms"].get<double>(), 0.0);
     EXPECT_GE(result["p95_ms"].get<double>(), result["median_ms"].get<double>());
-    const double drawn = result["fiblets_drawn_fraction"].get<double>();
-    const double lod = result["fiblets_lod_fraction"].get<double>();
-    EXPECT_GT(drawn + lod, 0.0) << result.dump();
-    EXPECT_LE(drawn + lod, 1.0) << result.dump();
+    EXPECT_GT(result["segments_drawn_per_ms"].get<double>(), 0.0);
+    if (result["pipeline"] == "lines") {
+      EXPECT_TRUE(result["pass_mean_ms"].contains("lines")) << result.dump();
+      EXPECT_FALSE(result.contains("fiblets_drawn_fraction")) << "the baselines draw no fiblets";
+      continue;
+    }
+    if (result["pipeline"] != "raw-compute") {
+      const double drawn = result["fiblets_drawn_fraction"].get<double>();
+      const double lod = result["fiblets_lod_fraction"].get<double>();
+      EXPECT_GT(drawn + lod, 0.0) << result.dump();
+      EXPECT_LE(drawn + lod, 1.0) << result.dump();
+    }
     bool raster = false;
     for (const auto& [name, ms] : result["pass_mean_ms"].items()) raster |= name.rfind("raster", 0) == 0;
     EXPECT_TRUE(raster) << result.dump();
