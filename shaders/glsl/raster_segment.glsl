@@ -44,10 +44,9 @@ void rasterPixel(VisibilityRef vis, uint width, int px, int py, vec3 a, vec3 ab,
   if (key < vis.keys[index]) atomicMin(vis.keys[index], key);
 }
 
-// Steps 1-7 for the world-space segment p0 -> p1.
-void rasterSegment(VisibilityRef vis, CameraBlock cam, vec3 p0, vec3 p1, uint64_t payload) {
-  vec4 c0 = cameraTransformPoint(cam.view_projection, p0);
-  vec4 c1 = cameraTransformPoint(cam.view_projection, p1);
+// Steps 2-7 for a segment whose ends are already in clip space (step 1):
+// a polyline projects each point once and passes consecutive pairs.
+void rasterClipSegment(VisibilityRef vis, CameraBlock cam, vec4 c0, vec4 c1, uint64_t payload) {
   if (segmentOutsideFrustum(c0, c1)) return;
   // Step 3: cut at the near plane z_clip = 0.
   if (c0.z < 0.0 || c1.z < 0.0) {
@@ -96,6 +95,12 @@ void rasterSegment(VisibilityRef vis, CameraBlock cam, vec3 p0, vec3 p1, uint64_
       rasterPixel(vis, width, px, py, a, ab, length2, radius2, payload);
     }
   }
+}
+
+// Steps 1-7 for the world-space segment p0 -> p1.
+void rasterSegment(VisibilityRef vis, CameraBlock cam, vec3 p0, vec3 p1, uint64_t payload) {
+  rasterClipSegment(vis, cam, cameraTransformPoint(cam.view_projection, p0), cameraTransformPoint(cam.view_projection, p1),
+                    payload);
 }
 
 #endif

@@ -66,7 +66,7 @@ struct FibletCullPush {
 // indirect dispatch size.
 struct FibletListFinalizePush {
   uint64_t list;
-  uint items_per_group;  // 1: the fiblet raster (a workgroup per fiblet); 64: the LoD raster
+  uint items_per_group;  // the fiblet raster: FibletPasses::raster_fiblets_per_group; 64: the LoD raster
   uint max_groups_x;     // maxComputeWorkGroupCount[0]
 };
 

@@ -79,11 +79,11 @@ void recordCull(VkCommandBuffer cmd, const gpu::VulkanContext& context, const Cu
 }
 
 void recordFinalize(VkCommandBuffer cmd, const gpu::VulkanContext& context, const CullPasses& passes,
-                    const CullBuffers& buffers) {
+                    const CullBuffers& buffers, const FibletPasses& fiblet_passes) {
   shader::FibletListFinalizePush push{};
   push.max_groups_x = context.limits().maxComputeWorkGroupCount[0];
   push.list = buffers.list.address;
-  push.items_per_group = 1;  // fiblet_raster.comp: a workgroup per fiblet
+  push.items_per_group = fiblet_passes.raster_fiblets_per_group;  // fiblet_raster.comp (1 on GPUs)
   gpu::recordDispatch(cmd, passes.finalize, push, 1);
   push.list = buffers.lod_list.address;
   push.items_per_group = kLodItemsPerGroup;
@@ -112,7 +112,7 @@ void recordPhase(VkCommandBuffer cmd, const gpu::VulkanContext& context, const C
   transferToCompute(cmd);
   recordCull(cmd, context, passes, dataset, frame, buffers, mode, cull);
   computeToCompute(cmd);
-  recordFinalize(cmd, context, passes, buffers);
+  recordFinalize(cmd, context, passes, buffers, fiblet_passes);
   gpu::endPass(cmd, timer);
   computeToIndirect(cmd);
 

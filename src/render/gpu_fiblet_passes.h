@@ -21,6 +21,7 @@ struct FibletPasses {
   gpu::ComputePipeline raster;   // fiblet_raster.comp
   gpu::ComputePipeline resolve;  // fiblet_resolve.comp
   uint32_t raster_lanes = 0;     // invocations per fiblet in the raster
+  uint32_t raster_fiblets_per_group = 1;  // fiblets per raster workgroup (1 on GPUs)
 };
 
 // The raster's invocations per fiblet for a device: its subgroup size

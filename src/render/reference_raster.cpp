@@ -182,7 +182,7 @@ void writePngRgba(const std::string& path, uint32_t width, uint32_t height, cons
   }
   uLongf packed_size = compressBound(uLong(raw.size()));
   std::vector<uint8_t> packed(packed_size);
-  if (compress2(packed.data(), &packed_size, raw.data(), uLong(raw.size()), 6) != Z_OK)
+  if (compress2(packed.data(), &packed_size, raw.data(), uLong(raw.size()), Z_BEST_SPEED) != Z_OK)
     fail(path, "PNG: zlib compression failed");
   packed.resize(packed_size);
 
