@@ -100,6 +100,10 @@ void runRender(const RenderCommandOptions& o) {
 void addRenderCommand(CLI::App& app) {
   auto o = std::make_shared<RenderCommandOptions>();
   CLI::App* cmd = app.add_subcommand("render", "Render one frame of a tractogram (or the built-in phantom) to a PNG");
+  // One frame has no previous frame to learn visibility from: two-phase
+  // culling would draw everything in its first phase and then only add a
+  // depth pyramid and a second cull. The frustum test and LoD still pay.
+  o->render.culling = "frustum";
   addRenderCliOptions(cmd, o->render);
   cmd->add_option("--view", o->view, "sagittal | coronal | axial");
   cmd->add_option("--camera", o->camera, "AZ,EL,DIST: orbit angles in degrees and distance factor (0: framed snugly, 1: the bounding sphere fits)");
