@@ -52,6 +52,11 @@ if [ "$mode" = run ]; then
   ./build/fibscope info out/phantom.tck
   # The fiblet compression of it, with the report (size, error, speed).
   ./build/fibscope compress out/phantom.tck out/phantom.fbl --report --force
+  # The renderer, headless (the interactive viewer is not built yet): the
+  # phantom compressed on the fly and drawn by the compute pipeline, lit,
+  # to a 1920x1080 PNG (lavapipe runs it on the CPU where there is no GPU).
+  ./build/fibscope render out/phantom.tck -o out/phantom.png
+  echo "setup: wrote out/phantom.png"
   exit 0
 fi
 
