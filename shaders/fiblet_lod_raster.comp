@@ -13,6 +13,7 @@
 #include "shared/cull_push.h"
 #include "glsl/fiblet_record.glsl"
 #include "glsl/raster_segment.glsl"
+#include "glsl/tangent.glsl"
 
 layout(local_size_x = 64) in;  // the finalize pass's items_per_group
 
@@ -43,4 +44,6 @@ void main() {
   const CameraBlock cam = CameraRef(pc.camera).camera;
   rasterSegment(VisibilityRef(pc.visibility), cam, fibletToWorld(ds, a), fibletToWorld(ds, b),
                 uint64_t(fiblet) << kKeySegmentBits);
+  // Its pixels resolve as segment 0: give that entry this segment's tangent.
+  if (pc.tangents != 0ul) UintsOutRef(pc.tangents).values[fiblet * 64u] = packSegmentTangent(b - a);
 }

@@ -30,6 +30,7 @@
 #include "shared/render_push.h"
 #include "glsl/fiblet_record.glsl"
 #include "glsl/raster_segment.glsl"
+#include "glsl/tangent.glsl"
 
 layout(constant_id = 0) const uint LANES = 64;         // 8, 16, 32 or 64
 layout(constant_id = 1) const uint GROUP_FIBLETS = 1;  // LANES * GROUP_FIBLETS <= 64
@@ -119,12 +120,17 @@ void main() {
   VisibilityRef vis = VisibilityRef(pc.visibility);
   const FibletTransform e = lane == 0u ? identityTransform() : partial[me - 1u];
   // Each point is projected once (clip space), each segment uses two.
-  vec4 a = cameraTransformPoint(cam.view_projection, fibletToWorld(ds, lane == 0u ? p0 : e.t));  // point `first`
+  vec3 a_world = fibletToWorld(ds, lane == 0u ? p0 : e.t);  // point `first`
+  vec4 a = cameraTransformPoint(cam.view_projection, a_world);
+  const bool cache = pc.tangents != 0ul;
+  UintsOutRef tangents = UintsOutRef(pc.tangents);
   for (uint k = first; k < end; ++k) {
     const vec3 b_world = fibletToWorld(ds, fibletRotate(e, local[k - first]) + e.t);  // point k + 1
     const vec4 b = cameraTransformPoint(cam.view_projection, b_world);
     rasterClipSegment(vis, cam, a, b, (uint64_t(fiblet) << kKeySegmentBits) | uint64_t(k));
+    if (cache) tangents.values[fiblet * kSlots + k] = packSegmentTangent(b_world - a_world);
     a = b;
+    a_world = b_world;
   }
   // The joining segment, drawn by the lane that owns the last point (point
   // `used`: lane 0 when the fiblet has one point).
@@ -133,5 +139,6 @@ void main() {
     const vec3 b = fibletToWorld(ds, fibletFirstPoint(records, base + ds.record_words));
     rasterClipSegment(vis, cam, a, cameraTransformPoint(cam.view_projection, b),
                       (uint64_t(fiblet) << kKeySegmentBits) | uint64_t(used));
+    if (cache) tangents.values[fiblet * kSlots + used] = packSegmentTangent(b - a_world);
   }
 }

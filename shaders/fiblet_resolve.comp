@@ -1,8 +1,9 @@
 // Resolve for the compute pipeline (DESIGN.md section 6, step 3): per pixel,
 // the winning key's payload (fiblet, segment) becomes a G-buffer texel: the
-// fiber from the per-fiblet fiber table, the tangent by decoding the fiblet
-// from its start up to the segment (sequential composition, at most 60
-// steps; only covered pixels pay for it).
+// fiber from the per-fiblet fiber table, the tangent from the rasters'
+// tangent cache when there is one, else by decoding the fiblet from its
+// start up to the segment (sequential composition, at most 60 steps; only
+// covered pixels pay for it).
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_buffer_reference : require
@@ -31,38 +32,42 @@ void main() {
     const uint64_t payload = visibilityPayload(key);
     const uint fiblet = uint(payload >> kKeySegmentBits);
     const uint segment = uint(payload) & ((1u << kKeySegmentBits) - 1u);
-    WordsRef records = WordsRef(ds.records);
-    const uint base = fiblet * ds.record_words;
-    const uint n = ds.points_per_fiblet;
-    const uint count = fibletCount(fibletRecordByte(records, base, fibletFlagsByte(n)));
-    const uint w0 = records.words[base], w1 = records.words[base + 1u], w2 = records.words[base + 2u];
-    const vec3 p0 = fibletRecordPoint(w0, w1, w2, 0u);
-    const vec3 v = vec3(ds.v_x, ds.v_y, ds.v_z);
-    vec3 a = p0, b = p0;
-    if (count >= 2u) {
-      // W_1, then W_k = W_{k-1} L_k: after k steps the translation is point k.
-      FibletTransform w = fibletInitialTransform(p0, fibletRecordPoint(w0, w1, w2, 1u), v);
-      const uint last = min(segment + 1u, count - 1u);
-      for (uint k = 2u; k <= last; ++k) {
-        a = w.t;
-        w = fibletCompose(w, fibletTableTransform(DirectionsRef(ds.directions),
-                                                  fibletRecordByte(records, base, fibletCodeByte(k))));
+    if (pc.tangents != 0ul) {
+      // The rasters left every drawn segment's tangent in the cache.
+      texel.tangent = UintsRef(pc.tangents).values[fiblet * 64u + segment];
+    } else {
+      WordsRef records = WordsRef(ds.records);
+      const uint base = fiblet * ds.record_words;
+      const uint n = ds.points_per_fiblet;
+      const uint count = fibletCount(fibletRecordByte(records, base, fibletFlagsByte(n)));
+      const uint w0 = records.words[base], w1 = records.words[base + 1u], w2 = records.words[base + 2u];
+      const vec3 p0 = fibletRecordPoint(w0, w1, w2, 0u);
+      const vec3 v = vec3(ds.v_x, ds.v_y, ds.v_z);
+      vec3 a = p0, b = p0;
+      if (count >= 2u) {
+        // W_1, then W_k = W_{k-1} L_k: after k steps the translation is point k.
+        FibletTransform w = fibletInitialTransform(p0, fibletRecordPoint(w0, w1, w2, 1u), v);
+        const uint last = min(segment + 1u, count - 1u);
+        for (uint k = 2u; k <= last; ++k) {
+          a = w.t;
+          w = fibletCompose(w, fibletTableTransform(DirectionsRef(ds.directions),
+                                                    fibletRecordByte(records, base, fibletCodeByte(k))));
+        }
+        if (segment + 1u < count) {
+          if (segment == 0u) a = p0;
+          b = w.t;
+        } else {
+          a = w.t;  // the joining segment: last point -> next fiblet's first point
+        }
       }
-      if (segment + 1u < count) {
-        if (segment == 0u) a = p0;
-        b = w.t;
-      } else {
-        a = w.t;  // the joining segment: last point -> next fiblet's first point
-      }
+      if (segment + 1u >= count) b = fibletFirstPoint(records, base + ds.record_words);
+      // Normalised -> world is a uniform scale plus a translation: the unit
+      // tangent is the same in both spaces.
+      texel.tangent = packSegmentTangent(b - a);
     }
-    if (segment + 1u >= count) b = fibletFirstPoint(records, base + ds.record_words);
-    // Normalised -> world is a uniform scale plus a translation: the unit
-    // tangent is the same in both spaces.
-    const vec3 d = b - a;
     texel.depth = visibilityDepth(key);
     texel.fiber = UintsRef(ds.fiblet_fiber).values[fiblet];
     texel.segment = segment;
-    texel.tangent = dot(d, d) > 0.0 ? packTangent(normalize(d)) : 0u;
   }
   GBufferRef(pc.gbuffer).texels[index] = texel;
 }

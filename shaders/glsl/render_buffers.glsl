@@ -14,6 +14,7 @@ layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer Ca
 layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer DatasetRef { FibletDataset ds; };
 layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer WordsRef { uint words[]; };
 layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer UintsRef { uint values[]; };
+layout(buffer_reference, std430, buffer_reference_align = 4) writeonly buffer UintsOutRef { uint values[]; };
 layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer FloatsRef { float values[]; };
 layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer DirectionsRef { vec4 directions[]; };
 layout(buffer_reference, std430, buffer_reference_align = 8) buffer VisibilityRef { uint64_t keys[]; };

@@ -12,6 +12,12 @@ uint packTangent(vec3 t) {
   return packSnorm2x16(p);
 }
 
+// The packed unit tangent of a segment's direction (zero: 0, as the
+// resolve writes for a zero-length segment).
+uint packSegmentTangent(vec3 d) {
+  return dot(d, d) > 0.0 ? packTangent(normalize(d)) : 0u;
+}
+
 vec3 unpackTangent(uint packed) {
   const vec2 p = unpackSnorm2x16(packed);
   vec3 t = vec3(p, 1.0 - abs(p.x) - abs(p.y));

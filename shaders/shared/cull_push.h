@@ -86,6 +86,7 @@ struct FibletLodRasterPush {
   uint64_t camera;
   uint64_t visibility;
   uint64_t list;
+  uint64_t tangents;  // 0 or the tangent cache (render_push.h): segment 0's entry
 };
 
 // Size of pyramid level `level` of a width x height frame: level 0 is the
@@ -126,7 +127,7 @@ SHADER_NAMESPACE_END
 static_assert(sizeof(fibscope::shader::FibletCullPush) == 64, "");
 static_assert(sizeof(fibscope::shader::FibletListFinalizePush) == 16, "");
 static_assert(sizeof(fibscope::shader::DepthPyramidPush) == 32, "");
-static_assert(sizeof(fibscope::shader::FibletLodRasterPush) == 32, "");
+static_assert(sizeof(fibscope::shader::FibletLodRasterPush) == 40, "");
 #endif
 
 #endif  // FIBSCOPE_SHADERS_SHARED_CULL_PUSH_H

@@ -2,6 +2,7 @@
 
 #include <cstring>
 
+#include "core/mapped_file.h"
 #include "gpu/submit.h"
 #include "gpu/vk_check.h"
 
@@ -62,7 +63,20 @@ VkDeviceMemory allocateMemory(const VulkanContext& context, const VkMemoryRequir
   if (r == VK_ERROR_OUT_OF_DEVICE_MEMORY || r == VK_ERROR_OUT_OF_HOST_MEMORY)
     throw Error("vulkan: out of memory allocating " + mib(requirements.size) + " on " + context.info().name);
   throwIfFailed(r, "vkAllocateMemory");
-  if (properties) *properties = context.memoryProperties().memoryTypes[type].propertyFlags;
+  const VkMemoryPropertyFlags flags_of_type = context.memoryProperties().memoryTypes[type].propertyFlags;
+  if (properties) *properties = flags_of_type;
+  // On a CPU device (lavapipe) "device memory" is the process's own: large
+  // buffers (visibility, G-buffer, tangent cache, datasets) would take one
+  // page fault per 4 KiB on first use, about a fifth of the first frame of
+  // a large tractogram. Transparent huge pages make that one per 2 MiB.
+  if (context.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU && (flags_of_type & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT) &&
+      requirements.size >= (VkDeviceSize(4) << 20)) {
+    void* mapped = nullptr;
+    if (vkMapMemory(context.device(), memory, 0, VK_WHOLE_SIZE, 0, &mapped) == VK_SUCCESS) {
+      adviseHugePages(mapped, size_t(requirements.size));
+      vkUnmapMemory(context.device(), memory);
+    }
+  }
   return memory;
 }
 

@@ -97,6 +97,7 @@ void recordLodRaster(VkCommandBuffer cmd, const CullPasses& passes, const GpuDat
   push.camera = frame.camera.address;
   push.visibility = frame.visibility.address;
   push.list = buffers.lod_list.address;
+  push.tangents = frame.tangents.address;
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, passes.lod_raster.pipeline);
   vkCmdPushConstants(cmd, passes.lod_raster.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
   vkCmdDispatchIndirect(cmd, buffers.lod_list.buffer, 0);

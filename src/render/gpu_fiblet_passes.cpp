@@ -58,6 +58,7 @@ void recordFibletRasterAll(VkCommandBuffer cmd, const gpu::VulkanContext& contex
   push.camera = frame.camera.address;
   push.visibility = frame.visibility.address;
   push.list = 0;
+  push.tangents = frame.tangents.address;
   const gpu::DispatchGrid grid =
       gpu::dispatchGrid(context, (uint64_t(fiblets) + passes.raster_fiblets_per_group - 1) / passes.raster_fiblets_per_group);
   gpu::recordDispatch(cmd, passes.raster, push, grid.x, grid.y);
@@ -70,6 +71,7 @@ void recordFibletRasterList(VkCommandBuffer cmd, const FibletPasses& passes, con
   push.camera = frame.camera.address;
   push.visibility = frame.visibility.address;
   push.list = list.address;
+  push.tangents = frame.tangents.address;
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, passes.raster.pipeline);
   vkCmdPushConstants(cmd, passes.raster.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
   vkCmdDispatchIndirect(cmd, list.buffer, 0);
@@ -81,6 +83,7 @@ void recordFibletResolve(VkCommandBuffer cmd, const FibletPasses& passes, const 
   push.dataset = dataset.blockAddress();
   push.visibility = frame.visibility.address;
   push.gbuffer = frame.gbuffer.address;
+  push.tangents = frame.tangents.address;
   push.width = frame.width;
   push.height = frame.height;
   gpu::recordDispatch(cmd, passes.resolve, push, pixelGroupsX(frame), pixelGroupsY(frame));

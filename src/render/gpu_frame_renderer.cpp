@@ -122,6 +122,9 @@ void FrameRenderer::record(VkCommandBuffer cmd, const Camera& camera, const Rend
   } else {
     const GpuDataset& dataset = *scene.fiblets;
     pending_.fiblets_total = dataset.block().fiblet_count;
+    // The rasters keep each drawn segment's tangent so the resolve need
+    // not decode again (when the dataset's cache fits the budget).
+    prepareTangentCache(context_, targets_, dataset.block().fiblet_count);
     cull_stats_pending_ = settings.culling != CullingMode::None && pending_.fiblets_total > 0;
     if (cull_stats_pending_) {
       // Cull passes, both rasters (and the pyramid and second phase for

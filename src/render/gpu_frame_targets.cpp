@@ -1,5 +1,6 @@
 #include "render/gpu_frame_targets.h"
 
+#include <algorithm>
 #include <string>
 
 #include "core/error.h"
@@ -30,11 +31,40 @@ GpuFrameTargets createFrameTargets(const gpu::VulkanContext& context, uint32_t w
 }
 
 void destroyFrameTargets(const gpu::VulkanContext& context, GpuFrameTargets& targets) {
+  gpu::destroyBuffer(context, targets.tangents);
   gpu::destroyBuffer(context, targets.color);
   gpu::destroyBuffer(context, targets.gbuffer);
   gpu::destroyBuffer(context, targets.visibility);
   gpu::destroyBuffer(context, targets.camera);
   targets = {};
+}
+
+void prepareTangentCache(const gpu::VulkanContext& context, GpuFrameTargets& targets, uint32_t fiblets) {
+  const uint64_t bytes = uint64_t(fiblets) * 64 * sizeof(uint32_t);
+  uint64_t heap = 0;
+  const VkPhysicalDeviceMemoryProperties& memory = context.memoryProperties();
+  for (uint32_t i = 0; i < memory.memoryHeapCount; ++i)
+    if (memory.memoryHeaps[i].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT) heap = std::max(heap, memory.memoryHeaps[i].size);
+  const uint64_t budget = std::min({kTangentCacheBudget, heap / 4, uint64_t(context.info().max_memory_allocation_size)});
+  if (fiblets == 0 || bytes > budget) {
+    if (targets.tangents.buffer) {
+      vkDeviceWaitIdle(context.device());
+      gpu::destroyBuffer(context, targets.tangents);
+    }
+    targets.tangent_fiblets = 0;
+    return;
+  }
+  targets.tangent_fiblets = fiblets;
+  if (targets.tangents.size >= bytes) return;
+  if (targets.tangents.buffer) {
+    vkDeviceWaitIdle(context.device());
+    gpu::destroyBuffer(context, targets.tangents);
+  }
+  try {
+    targets.tangents = gpu::createBuffer(context, bytes, gpu::MemoryUse::DeviceLocal);
+  } catch (const Error&) {
+    targets.tangent_fiblets = 0;  // out of memory: resolve by decoding
+  }
 }
 
 std::vector<uint8_t> downloadColor(const gpu::VulkanContext& context, const GpuFrameTargets& targets) {

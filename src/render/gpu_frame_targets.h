@@ -21,6 +21,11 @@ struct GpuFrameTargets {
   gpu::Buffer visibility;  // uint64_t key per pixel (shared/render_config.h)
   gpu::Buffer gbuffer;     // GBufferTexel per pixel (shared/gbuffer.h)
   gpu::Buffer color;       // RGBA8 per pixel as one uint (R in the low byte), top row first
+  // Optional (empty: address 0): the packed tangent of every segment the
+  // fiblet rasters draw, a uint at fiblet * 64 + segment, so the resolve
+  // reads it instead of decoding the fiblet again per pixel (render_push.h).
+  gpu::Buffer tangents;
+  uint32_t tangent_fiblets = 0;  // fiblets the cache holds
   uint64_t pixels() const { return uint64_t(width) * height; }
 };
 
@@ -28,6 +33,16 @@ struct GpuFrameTargets {
 // size above 16384 px per side, or when memory runs out.
 GpuFrameTargets createFrameTargets(const gpu::VulkanContext& context, uint32_t width, uint32_t height);
 void destroyFrameTargets(const gpu::VulkanContext& context, GpuFrameTargets& targets);
+
+// The tangent cache's budget: 256 bytes a fiblet (4 times its record) is
+// worth it below this, or a quarter of the device-local heap if smaller;
+// larger datasets resolve by decoding.
+inline constexpr uint64_t kTangentCacheBudget = uint64_t(1) << 30;
+// Makes targets.tangents hold `fiblets` fiblets when that fits the budget
+// (reusing a large enough buffer), else releases it. Call outside of any
+// recording that uses the old buffer (waits for the device when it
+// replaces a buffer).
+void prepareTangentCache(const gpu::VulkanContext& context, GpuFrameTargets& targets, uint32_t fiblets);
 
 // Read-backs for tests and PNG output (wait for the queue).
 std::vector<uint8_t> downloadColor(const gpu::VulkanContext& context, const GpuFrameTargets& targets);

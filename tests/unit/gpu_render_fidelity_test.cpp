@@ -6,6 +6,9 @@
 // Validation layers on (GpuTest fails on any message).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdio>
 #include <vector>
 
@@ -37,6 +40,20 @@ std::vector<uint8_t> gbufferMask(const std::vector<shader::GBufferTexel>& texels
   std::vector<uint8_t> mask(texels.size());
   for (size_t i = 0; i < texels.size(); ++i) mask[i] = texels[i].fiber != shader::kNoFiberId ? 1 : 0;
   return mask;
+}
+
+// glsl/tangent.glsl's unpackTangent: snorm16 x 2, octahedral.
+std::array<double, 3> unpackTangentForTest(uint32_t packed) {
+  auto snorm = [](uint16_t bits) { return std::clamp(double(int16_t(bits)) / 32767.0, -1.0, 1.0); };
+  const double x = snorm(uint16_t(packed & 0xFFFFu)), y = snorm(uint16_t(packed >> 16));
+  std::array<double, 3> t = {x, y, 1.0 - std::fabs(x) - std::fabs(y)};
+  if (t[2] < 0) {
+    const double tx = (1.0 - std::fabs(y)) * (x >= 0 ? 1.0 : -1.0), ty = (1.0 - std::fabs(x)) * (y >= 0 ? 1.0 : -1.0);
+    t[0] = tx;
+    t[1] = ty;
+  }
+  const double n = std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+  return {t[0] / n, t[1] / n, t[2] / n};
 }
 
 class GpuRenderFidelity : public test::GpuTest {};
@@ -110,8 +127,37 @@ TEST_F(GpuRenderFidelity, everyRasterWidthMatchesTheReference) {
                          VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
       recordFibletResolve(cmd, passes, upload.dataset, frame);
     });
+    const std::vector<shader::GBufferTexel> decoded = downloadGBuffer(context(), frame);
+    // The same frame with the tangent cache: the resolve reads the rasters'
+    // tangents instead of decoding; the texels must agree (tangents to the
+    // packing's precision: computed in world and in normalised space).
+    prepareTangentCache(context(), frame, upload.dataset.block().fiblet_count);
+    ASSERT_NE(frame.tangents.address, 0u);
+    gpu::submitOnce(context(), [&](VkCommandBuffer cmd) {
+      vkCmdFillBuffer(cmd, frame.visibility.buffer, 0, VK_WHOLE_SIZE, 0xFFFFFFFFu);
+      gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                         VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                         VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+      recordFibletRasterAll(cmd, context(), passes, upload.dataset, frame);
+      gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                         VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT,
+                         VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
+      recordFibletResolve(cmd, passes, upload.dataset, frame);
+    });
+    const std::vector<shader::GBufferTexel> cached = downloadGBuffer(context(), frame);
+    prepareTangentCache(context(), frame, 0);
+    size_t covered = 0, differ = 0;
+    for (size_t i = 0; i < decoded.size(); ++i) {
+      ASSERT_EQ(decoded[i].fiber, cached[i].fiber) << i;
+      ASSERT_EQ(decoded[i].segment, cached[i].segment) << i;
+      if (decoded[i].fiber == shader::kNoFiberId) continue;
+      ++covered;
+      const auto a = unpackTangentForTest(decoded[i].tangent), b = unpackTangentForTest(cached[i].tangent);
+      differ += std::fabs(a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) < 0.99999;
+    }
+    EXPECT_EQ(differ, 0u) << "of " << covered << " covered pixels have different tangents";
     destroyFibletPasses(context(), passes);
-    const std::vector<uint8_t> mask = gbufferMask(downloadGBuffer(context(), frame));
+    const std::vector<uint8_t> mask = gbufferMask(decoded);
     const CoverageComparison c = compareCoverage(mask, reference.coverageMask(), kSize, kSize);
     EXPECT_GE(c.agreement, 0.98) << c.summary();
     EXPECT_LE(c.maxDistance(), 1.0) << c.summary();
