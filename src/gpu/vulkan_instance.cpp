@@ -88,6 +88,8 @@ DeviceInfo describeDevice(VkPhysicalDevice device, uint32_t index) {
     vkGetPhysicalDeviceProperties2(device, &props);
     vkGetPhysicalDeviceFeatures2(device, &features);
     info.subgroup_size = subgroup.subgroupSize;
+    info.subgroup_shuffle_relative = (subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) &&
+                                     (subgroup.supportedOperations & VK_SUBGROUP_FEATURE_SHUFFLE_RELATIVE_BIT);
     info.max_memory_allocation_size = maintenance3.maxMemoryAllocationSize;
     if (api >= VK_API_VERSION_1_2) {
       info.driver_name = driver.driverName;

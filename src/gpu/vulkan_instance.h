@@ -63,6 +63,8 @@ struct DeviceInfo {
   std::string driver_name;  // e.g. "llvmpipe", "NVIDIA"
   std::string driver_info;  // e.g. "Mesa 22.3.6 (LLVM 15.0.6)"
   uint32_t subgroup_size = 0;
+  // Compute shaders may use subgroupShuffleUp (KHR_shader_subgroup_shuffle_relative).
+  bool subgroup_shuffle_relative = false;
   uint64_t max_storage_buffer_range = 0;
   uint32_t max_push_constants_size = 0;
   uint64_t max_memory_allocation_size = 0;

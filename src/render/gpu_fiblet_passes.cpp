@@ -14,12 +14,19 @@ uint32_t defaultRasterLanes(const gpu::VulkanContext& context) {
   return lanes;
 }
 
-FibletPasses createFibletPasses(const gpu::VulkanContext& context, uint32_t raster_lanes) {
+FibletPasses createFibletPasses(const gpu::VulkanContext& context, uint32_t raster_lanes, RasterScan scan) {
   if (raster_lanes == 0) raster_lanes = defaultRasterLanes(context);
   if (raster_lanes != 8 && raster_lanes != 16 && raster_lanes != 32 && raster_lanes != 64)
     throw Error("fiblet raster: lanes per fiblet must be 8, 16, 32 or 64, got " + std::to_string(raster_lanes));
+  const bool subgroup_ok = context.info().subgroup_shuffle_relative && context.info().subgroup_size == raster_lanes;
+  if (scan == RasterScan::Subgroup && !subgroup_ok)
+    throw Error("fiblet raster: a subgroup scan needs " + std::to_string(raster_lanes) +
+                "-wide subgroups with relative shuffles; " + context.info().name + " has " +
+                std::to_string(context.info().subgroup_size) + "-wide subgroups" +
+                (context.info().subgroup_shuffle_relative ? "" : " without relative shuffles"));
   FibletPasses passes;
   passes.raster_lanes = raster_lanes;
+  passes.raster_subgroup_scan = scan == RasterScan::Subgroup || (scan == RasterScan::Auto && subgroup_ok);
   try {
     // CPU devices (lavapipe) pay about a microsecond per workgroup: pack
     // 64 invocations' worth of fiblets into each; GPUs get the paper's one
@@ -27,8 +34,9 @@ FibletPasses createFibletPasses(const gpu::VulkanContext& context, uint32_t rast
     passes.raster_fiblets_per_group = context.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 64 / raster_lanes : 1;
     const uint32_t specialization[] = {raster_lanes, passes.raster_fiblets_per_group,
                                        raster_lanes * passes.raster_fiblets_per_group};
-    passes.raster = gpu::createComputePipeline(context, "fiblet_raster.comp", sizeof(shader::FibletRasterPush),
-                                               specialization);
+    passes.raster = gpu::createComputePipeline(
+        context, passes.raster_subgroup_scan ? "fiblet_raster_subgroup.comp" : "fiblet_raster.comp",
+        sizeof(shader::FibletRasterPush), specialization);
     passes.resolve = gpu::createComputePipeline(context, "fiblet_resolve.comp", sizeof(shader::FibletResolvePush));
   } catch (...) {
     destroyFibletPasses(context, passes);

@@ -102,7 +102,8 @@ TEST_F(GpuRenderFidelity, computePipelineMatchesTheCpuReferenceFromEveryView) {
 }
 
 // The raster's lanes per fiblet follow the subgroup size (8 on lavapipe, 32
-// on NVIDIA, 64 on AMD); every width must draw the same image.
+// on NVIDIA, 64 on AMD); every width, with the scan in shared memory or by
+// subgroup shuffles, must draw the same image.
 TEST_F(GpuRenderFidelity, everyRasterWidthMatchesTheReference) {
   const Tractogram fibers = phantom(300, 21);
   const TractogramUpload upload = uploadTractogram(context(), fibers, "phantom");
@@ -111,9 +112,22 @@ TEST_F(GpuRenderFidelity, everyRasterWidthMatchesTheReference) {
   const ReferenceFrame reference = rasterizeReference(fibers, camera, 2.0f);
   GpuFrameTargets frame = createFrameTargets(context(), kSize, kSize);
   std::vector<uint8_t> first_mask;
-  for (uint32_t lanes : {8u, 16u, 32u, 64u}) {
-    SCOPED_TRACE("lanes " + std::to_string(lanes));
-    FibletPasses passes = createFibletPasses(context(), lanes);
+  struct Variant {
+    uint32_t lanes;
+    RasterScan scan;
+  };
+  std::vector<Variant> variants = {{8, RasterScan::SharedMemory},
+                                   {16, RasterScan::SharedMemory},
+                                   {32, RasterScan::SharedMemory},
+                                   {64, RasterScan::SharedMemory}};
+  // The subgroup scan where the device's subgroups allow it (lavapipe: 8).
+  const uint32_t subgroup = context().info().subgroup_size;
+  if (context().info().subgroup_shuffle_relative && (subgroup == 8 || subgroup == 16 || subgroup == 32 || subgroup == 64))
+    variants.push_back({subgroup, RasterScan::Subgroup});
+  for (const Variant& variant : variants) {
+    const uint32_t lanes = variant.lanes;
+    SCOPED_TRACE("lanes " + std::to_string(lanes) + (variant.scan == RasterScan::Subgroup ? ", subgroup scan" : ""));
+    FibletPasses passes = createFibletPasses(context(), lanes, variant.scan);
     gpu::submitOnce(context(), [&](VkCommandBuffer cmd) {
       const shader::CameraBlock block = makeCameraBlock(camera, 2.0f);
       vkCmdUpdateBuffer(cmd, frame.camera.buffer, 0, sizeof(block), &block);

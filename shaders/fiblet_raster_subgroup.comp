@@ -1,0 +1,15 @@
+// The decode + raster pass of fiblet_raster.comp with the scan of the runs
+// done by subgroup shuffles (no shared memory, no barriers), for devices
+// whose subgroup size equals the lanes per fiblet and that support
+// KHR_shader_subgroup_shuffle_relative in compute shaders (lavapipe's 8,
+// NVIDIA's 32, AMD's 64). Chosen by createFibletPasses.
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_buffer_reference : require
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+#extension GL_EXT_shader_atomic_int64 : require
+#extension GL_KHR_shader_subgroup_basic : require
+#extension GL_KHR_shader_subgroup_shuffle_relative : require
+
+#define FIBLET_SUBGROUP_SCAN 1
+#include "glsl/fiblet_raster_body.glsl"
