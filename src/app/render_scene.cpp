@@ -25,20 +25,37 @@ uint64_t segmentCount(const Tractogram& t) {
 
 LoadedScene loadScene(const gpu::VulkanContext& context, const SceneOptions& options) {
   LoadedScene scene;
-  auto t0 = Clock::now();
-  std::unique_ptr<TractogramReader> reader;
-  if (options.path.empty()) {
-    PhantomOptions phantom;
-    phantom.streamlines = options.phantom_streamlines;
-    validatePhantomOptions(phantom);
-    scene.name = "phantom";
-    reader = openPhantom(phantom);
-  } else {
-    scene.name = options.path;
-    reader = openInput(options.path);
+  scene.name = options.path.empty() ? "phantom" : options.path;
+  PhantomOptions phantom;
+  phantom.streamlines = options.phantom_streamlines;
+  if (options.path.empty()) validatePhantomOptions(phantom);
+  auto open = [&]() { return options.path.empty() ? openPhantom(phantom) : openInput(options.path); };
+  auto printWarnings = [](const std::vector<std::string>& warnings) {
+    for (const std::string& warning : warnings) std::fprintf(stderr, "fibscope: warning: %s\n", warning.c_str());
+  };
+  const bool fbl = !options.path.empty() && isFblPath(options.path);
+
+  if (!fbl && !options.upload_raw) {
+    // The compute pipeline alone: stream the input twice (estimate, then
+    // encode chunks as they are read); the points are never all in memory.
+    StreamedUpload streamed = uploadStreamed(context, open, scene.name);
+    printWarnings(streamed.warnings);
+    if (streamed.streamlines == 0) throw Error(scene.name + ": no streamlines to render");
+    scene.fiblets = std::move(streamed.upload.dataset);
+    scene.bounds = streamed.bounds;
+    scene.sample = std::move(streamed.sample);
+    scene.streamlines = streamed.streamlines;
+    scene.segments = streamed.segments;
+    scene.read_seconds = streamed.read_seconds;
+    scene.encode_seconds = streamed.upload.encode_seconds;
+    scene.upload_seconds = streamed.upload.upload_seconds;
+    return scene;
   }
+
+  auto t0 = Clock::now();
+  std::unique_ptr<TractogramReader> reader = open();
   Tractogram points = readAllStreamlines(*reader);
-  for (const std::string& warning : reader->warnings()) std::fprintf(stderr, "fibscope: warning: %s\n", warning.c_str());
+  printWarnings(reader->warnings());
   if (points.streamlineCount() == 0) throw Error(scene.name + ": no streamlines to render");
   scene.read_seconds = secondsSince(t0);
   scene.bounds = tractogramBounds(points);
@@ -46,7 +63,7 @@ LoadedScene loadScene(const gpu::VulkanContext& context, const SceneOptions& opt
   scene.streamlines = points.streamlineCount();
   scene.segments = segmentCount(points);
 
-  if (!options.path.empty() && isFblPath(options.path)) {
+  if (fbl) {
     // Already fiblets: upload the records as stored (the decode above gave
     // the box and, for the baselines, the points).
     t0 = Clock::now();

@@ -1,9 +1,14 @@
 #include "render/gpu_tractogram_upload.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <deque>
 #include <future>
+#include <limits>
 
 #include "codec/fiblet_encoder.h"
+#include "core/error.h"
 #include "core/thread_pool.h"
 
 namespace fibscope {
@@ -64,6 +69,28 @@ EncodedFiblets encodeInParallel(const Tractogram& tractogram, const CodecParams&
   return all;
 }
 
+// Joins encoded parts (in input order) into one EncodedFiblets.
+EncodedFiblets joinParts(std::deque<EncodedFiblets>& parts, uint32_t record_bytes) {
+  EncodedFiblets all;
+  all.record_bytes = record_bytes;
+  size_t bytes = 0, fibers = 0;
+  for (const EncodedFiblets& part : parts) {
+    bytes += part.bytes.size();
+    fibers += part.fiberCount();
+  }
+  all.bytes.reserve(bytes);
+  all.fiber_first_fiblet.reserve(fibers);
+  all.fiber_points.reserve(fibers);
+  for (EncodedFiblets& part : parts) {
+    const uint32_t base = uint32_t(all.fibletCount());
+    all.bytes.insert(all.bytes.end(), part.bytes.begin(), part.bytes.end());
+    for (uint32_t first : part.fiber_first_fiblet) all.fiber_first_fiblet.push_back(base + first);
+    all.fiber_points.insert(all.fiber_points.end(), part.fiber_points.begin(), part.fiber_points.end());
+    part = {};
+  }
+  return all;
+}
+
 }  // namespace
 
 std::vector<float> streamlineLengths(const Tractogram& tractogram) {
@@ -71,6 +98,95 @@ std::vector<float> streamlineLengths(const Tractogram& tractogram) {
   for (size_t s = 0; s < lengths.size(); ++s)
     lengths[s] = polylineLength(tractogram.point(tractogram.offsets[s]), tractogram.pointsIn(s));
   return lengths;
+}
+
+StreamedUpload uploadStreamed(const gpu::VulkanContext& context,
+                              const std::function<std::unique_ptr<TractogramReader>()>& open,
+                              const std::string& name, Progress* progress) {
+  using Clock = std::chrono::steady_clock;
+  StreamedUpload out;
+  auto t0 = Clock::now();
+  // Pass 1: codec parameters, the box, a sample of the points (every
+  // stride-th point, stride doubling when the sample passes 8192).
+  CodecParamEstimator estimator;
+  Bounds& box = out.bounds;
+  box.min.fill(std::numeric_limits<double>::infinity());
+  box.max.fill(-std::numeric_limits<double>::infinity());
+  uint64_t stride = 1, next = 0;
+  {
+    auto reader = open();
+    Tractogram chunk;
+    while (reader->read(chunk, kEncodeChunkPoints)) {
+      estimator.add(chunk);
+      const Bounds b = tractogramBounds(chunk);
+      for (int k = 0; k < 3; ++k) {
+        box.min[k] = std::min(box.min[k], b.min[k]);
+        box.max[k] = std::max(box.max[k], b.max[k]);
+      }
+      for (; next < out.points + chunk.pointCount(); next += stride) {
+        const float* p = chunk.point(next - out.points);
+        if (std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2])) out.sample.push_back({p[0], p[1], p[2]});
+        if (out.sample.size() > 8192) {
+          for (size_t i = 0; 2 * i < out.sample.size(); ++i) out.sample[i] = out.sample[2 * i];
+          out.sample.resize((out.sample.size() + 1) / 2);
+          stride *= 2;
+        }
+      }
+      out.points += chunk.pointCount();
+      out.streamlines += chunk.streamlineCount();
+      for (size_t s = 0; s < chunk.streamlineCount(); ++s) out.segments += chunk.pointsIn(s) > 1 ? chunk.pointsIn(s) - 1 : 0;
+    }
+    out.warnings = reader->warnings();
+  }
+  if (out.streamlines == 0) throw Error(name + ": no streamlines to render");
+  try {
+    out.upload.params = estimator.finish();  // throws for no points or an absurd box
+  } catch (const Error& e) {
+    throw Error(name + ": " + e.what());
+  }
+  out.read_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+
+  // Pass 2: chunks encoded on the pool as they are read, at most
+  // 2 x workers in flight; parts and lengths kept in input order.
+  t0 = Clock::now();
+  // Declared before the pool, so that on an exception the pool (destroyed
+  // first) finishes its jobs before what they write to goes away; deques,
+  // so that appending never moves an element a job is writing.
+  std::deque<EncodedFiblets> parts;
+  std::deque<std::vector<float>> lengths;
+  std::vector<std::unique_ptr<FibletEncoder>> encoders;
+  ThreadPool pool;
+  for (unsigned i = 0; i < pool.size(); ++i) encoders.push_back(std::make_unique<FibletEncoder>(out.upload.params));
+  std::deque<std::future<void>> in_flight;
+  {
+    auto reader = open();
+    for (;;) {
+      auto chunk = std::make_shared<Tractogram>();
+      if (!reader->read(*chunk, kEncodeChunkPoints)) break;
+      EncodedFiblets* part = &parts.emplace_back();
+      std::vector<float>* part_lengths = &lengths.emplace_back();
+      if (in_flight.size() >= 2 * size_t(pool.size())) {
+        in_flight.front().get();
+        in_flight.pop_front();
+      }
+      in_flight.push_back(pool.submit([chunk, part, part_lengths, &encoders](unsigned worker) {
+        encoders[worker]->encode(*chunk, *part);
+        part_lengths->resize(chunk->streamlineCount());
+        for (size_t s = 0; s < part_lengths->size(); ++s)
+          (*part_lengths)[s] = polylineLength(chunk->point(chunk->offsets[s]), chunk->pointsIn(s));
+      }));
+    }
+  }
+  for (auto& d : in_flight) d.get();
+  const EncodedFiblets encoded = joinParts(parts, out.upload.params.recordBytes());
+  std::vector<float> all_lengths;
+  all_lengths.reserve(out.streamlines);
+  for (const auto& l : lengths) all_lengths.insert(all_lengths.end(), l.begin(), l.end());
+  const auto t1 = Clock::now();
+  out.upload.encode_seconds = std::chrono::duration<double>(t1 - t0).count();
+  out.upload.dataset = GpuDataset::upload(context, encoded, out.upload.params, all_lengths, name, progress);
+  out.upload.upload_seconds = std::chrono::duration<double>(Clock::now() - t1).count();
+  return out;
 }
 
 TractogramUpload uploadTractogram(const gpu::VulkanContext& context, const Tractogram& tractogram,

@@ -88,6 +88,17 @@ TEST_F(GpuCliRender, malformedInputIsNamedAndLeavesNoPng) {
   EXPECT_FALSE(std::filesystem::exists(png));
 }
 
+TEST_F(GpuCliRender, emptyTractogramIsNamedAndLeavesNoPng) {
+  const std::string tck = dir_.file("empty.tck");
+  writeTractogram(tck, Tractogram{}, TractogramHeader{});
+  const std::string png = dir_.file("x.png");
+  const auto r = test::runFibscope("render " + tck + " -o " + png);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_EQ(lineCount(r.output), 1) << r.output;
+  EXPECT_NE(r.output.find(tck + ": no streamlines"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(png));
+}
+
 TEST_F(GpuCliRender, benchReportsTheOrbitAsJson) {
   const auto r = test::runFibscope(
       "bench --validate --json --phantom-streamlines 200 --size 192x128 --frames 4 --warmup 1 "

@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "codec/codec_params.h"
 #include "codec/fiblet_encoder.h"
 #include "gpu/submit.h"
 #include "gpu_test_context.h"
@@ -198,6 +199,37 @@ TEST_F(GpuRenderFidelity, onTheFlyUploadEncodesInParallelLikeTheSequentialEncode
   std::vector<uint32_t> first(expected.fiberCount() + 1);
   gpu::downloadFromBuffer(context(), upload.dataset.fiberFirstFiblet(), first.data(), first.size() * 4);
   for (size_t f = 0; f < expected.fiberCount(); ++f) ASSERT_EQ(first[f], expected.fiber_first_fiblet[f]) << f;
+}
+
+TEST_F(GpuRenderFidelity, streamedUploadEqualsTheInMemoryOne) {
+  // Two passes over a reader (what `render FILE` does for the compute
+  // pipeline) against the whole tractogram in memory: same parameters,
+  // records, tables, box and counts.
+  PhantomOptions options;
+  options.streamlines = 700;
+  options.step_mm = 0.1;
+  options.seed = 9;
+  options.threads = 1;
+  const Tractogram fibers = readAllStreamlines(*openPhantom(options));
+  const StreamedUpload streamed = uploadStreamed(context(), [&] { return openPhantom(options); }, "phantom");
+  const CodecParams params = chooseCodecParams(fibers);
+  EXPECT_EQ(streamed.upload.params.delta, params.delta);
+  EXPECT_EQ(streamed.upload.params.alpha, params.alpha);
+  EXPECT_EQ(streamed.upload.params.scale, params.scale);
+  EXPECT_EQ(streamed.streamlines, fibers.streamlineCount());
+  EXPECT_EQ(streamed.points, fibers.pointCount());
+  const Bounds box = tractogramBounds(fibers);
+  EXPECT_EQ(streamed.bounds.min, box.min);
+  EXPECT_EQ(streamed.bounds.max, box.max);
+  EXPECT_GT(streamed.sample.size(), 1000u);
+  const EncodedFiblets expected = encodeTractogram(fibers, params);
+  ASSERT_EQ(streamed.upload.dataset.block().fiblet_count, expected.fibletCount());
+  std::vector<uint8_t> records(expected.bytes.size());
+  gpu::downloadFromBuffer(context(), streamed.upload.dataset.records(), records.data(), records.size());
+  EXPECT_TRUE(records == expected.bytes);
+  std::vector<float> lengths(fibers.streamlineCount());
+  gpu::downloadFromBuffer(context(), streamed.upload.dataset.fiberLength(), lengths.data(), lengths.size() * 4);
+  EXPECT_TRUE(lengths == streamlineLengths(fibers));
 }
 
 }  // namespace
