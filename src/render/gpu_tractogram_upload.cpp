@@ -20,55 +20,6 @@ namespace {
 // parts are then joined in order.
 constexpr size_t kEncodeChunkPoints = size_t(1) << 18;
 
-EncodedFiblets encodeInParallel(const Tractogram& tractogram, const CodecParams& params) {
-  struct Part {
-    size_t first = 0, end = 0;  // fibers
-    EncodedFiblets encoded;
-  };
-  std::vector<Part> parts;
-  for (size_t s = 0; s < tractogram.streamlineCount();) {
-    Part part;
-    part.first = s;
-    size_t points = 0;
-    while (s < tractogram.streamlineCount() && (points == 0 || points + tractogram.pointsIn(s) <= kEncodeChunkPoints))
-      points += tractogram.pointsIn(s++);
-    part.end = s;
-    parts.push_back(std::move(part));
-  }
-  ThreadPool pool;
-  std::vector<std::unique_ptr<FibletEncoder>> encoders;
-  std::vector<Tractogram> chunks(pool.size());
-  for (unsigned i = 0; i < pool.size(); ++i) encoders.push_back(std::make_unique<FibletEncoder>(params));
-  std::vector<std::future<void>> done;
-  for (Part& part : parts) {
-    done.push_back(pool.submit([&tractogram, &part, &encoders, &chunks](unsigned worker) {
-      Tractogram& chunk = chunks[worker];
-      chunk.clear();
-      for (size_t s = part.first; s < part.end; ++s)
-        chunk.addStreamline(tractogram.point(tractogram.offsets[s]), tractogram.pointsIn(s));
-      encoders[worker]->encode(chunk, part.encoded);
-    }));
-  }
-  for (auto& d : done) d.get();
-  EncodedFiblets all;
-  all.record_bytes = parts.empty() ? uint32_t(params.recordBytes()) : parts.front().encoded.record_bytes;
-  size_t bytes = 0, fibers = 0;
-  for (const Part& part : parts) {
-    bytes += part.encoded.bytes.size();
-    fibers += part.encoded.fiberCount();
-  }
-  all.bytes.reserve(bytes);
-  all.fiber_first_fiblet.reserve(fibers);
-  all.fiber_points.reserve(fibers);
-  for (const Part& part : parts) {
-    const uint32_t base = uint32_t(all.fibletCount());
-    all.bytes.insert(all.bytes.end(), part.encoded.bytes.begin(), part.encoded.bytes.end());
-    for (uint32_t first : part.encoded.fiber_first_fiblet) all.fiber_first_fiblet.push_back(base + first);
-    all.fiber_points.insert(all.fiber_points.end(), part.encoded.fiber_points.begin(), part.encoded.fiber_points.end());
-  }
-  return all;
-}
-
 // Joins encoded parts (in input order) into one EncodedFiblets.
 EncodedFiblets joinParts(std::deque<EncodedFiblets>& parts, uint32_t record_bytes) {
   EncodedFiblets all;
@@ -90,6 +41,37 @@ EncodedFiblets joinParts(std::deque<EncodedFiblets>& parts, uint32_t record_byte
   }
   return all;
 }
+
+EncodedFiblets encodeInParallel(const Tractogram& tractogram, const CodecParams& params) {
+  // Fiber ranges of about kEncodeChunkPoints points, in order.
+  std::vector<std::pair<size_t, size_t>> ranges;
+  for (size_t s = 0; s < tractogram.streamlineCount();) {
+    const size_t first = s;
+    size_t points = 0;
+    while (s < tractogram.streamlineCount() && (points == 0 || points + tractogram.pointsIn(s) <= kEncodeChunkPoints))
+      points += tractogram.pointsIn(s++);
+    ranges.emplace_back(first, s);
+  }
+  // Declared before the pool: the pool, destroyed first, finishes its jobs.
+  std::deque<EncodedFiblets> parts(ranges.size());
+  std::vector<std::unique_ptr<FibletEncoder>> encoders;
+  ThreadPool pool;
+  std::vector<Tractogram> chunks(pool.size());
+  for (unsigned i = 0; i < pool.size(); ++i) encoders.push_back(std::make_unique<FibletEncoder>(params));
+  std::vector<std::future<void>> done;
+  for (size_t i = 0; i < ranges.size(); ++i) {
+    done.push_back(pool.submit([&tractogram, range = ranges[i], part = &parts[i], &encoders, &chunks](unsigned worker) {
+      Tractogram& chunk = chunks[worker];
+      chunk.clear();
+      for (size_t s = range.first; s < range.second; ++s)
+        chunk.addStreamline(tractogram.point(tractogram.offsets[s]), tractogram.pointsIn(s));
+      encoders[worker]->encode(chunk, *part);
+    }));
+  }
+  for (auto& d : done) d.get();
+  return joinParts(parts, params.recordBytes());
+}
+
 
 }  // namespace
 
