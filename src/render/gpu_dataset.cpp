@@ -10,6 +10,7 @@
 #include "core/error.h"
 #include "gpu/submit.h"
 #include "gpu/vk_check.h"
+#include "render/gpu_staged_upload.h"
 
 namespace fibscope {
 
@@ -59,33 +60,6 @@ FiberTables deriveFiberTables(const std::string& name, std::span<const T> first,
   return tables;
 }
 
-// Copies `bytes` of `data` to the start of `destination` through
-// `staging`, one staging-full at a time, each copy submitted and waited for.
-void uploadChunked(const gpu::VulkanContext& context, const gpu::Buffer& staging, const gpu::Buffer& destination,
-                   const void* data, uint64_t bytes, Progress* progress) {
-  const auto* source = static_cast<const uint8_t*>(data);
-  for (uint64_t offset = 0; offset < bytes;) {
-    const uint64_t chunk = std::min<uint64_t>(staging.size, bytes - offset);
-    std::memcpy(staging.mapped, source + offset, size_t(chunk));
-    if (!staging.coherent) {
-      VkMappedMemoryRange range{VK_STRUCTURE_TYPE_MAPPED_MEMORY_RANGE};
-      range.memory = staging.memory;
-      range.size = VK_WHOLE_SIZE;
-      VK_CHECK(vkFlushMappedMemoryRanges(context.device(), 1, &range));
-    }
-    gpu::submitOnce(context, [&](VkCommandBuffer cmd) {
-      const VkBufferCopy copy{0, offset, chunk};
-      vkCmdCopyBuffer(cmd, staging.buffer, destination.buffer, 1, &copy);
-      // The fence orders the host only: make the copy visible to every
-      // later command on the queue (the passes that read the dataset).
-      gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                         VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
-                         VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT);
-    });
-    offset += chunk;
-    if (progress) progress->add(double(chunk));
-  }
-}
 
 }  // namespace
 
@@ -251,13 +225,14 @@ void GpuDataset::fill(const gpu::VulkanContext& context, const Source& source, c
   gpu::Buffer staging = gpu::createBuffer(
       context, std::clamp<uint64_t>(bytes.largest(), 4, std::max<uint64_t>(staging_bytes, 4)), gpu::MemoryUse::Upload);
   try {
-    uploadChunked(context, staging, records_, source.records.data(), bytes.records, progress);
-    uploadChunked(context, staging, fiblet_fiber_, source.tables.fiblet_fiber.data(), bytes.fiblet_fiber, progress);
-    uploadChunked(context, staging, directions_, table.data(), bytes.directions, progress);
-    uploadChunked(context, staging, fiber_first_fiblet_, source.tables.first.data(), bytes.fiber_first_fiblet,
+    uploadChunked(context, staging, records_, bytes.records, bytesOf(source.records.data()), progress);
+    uploadChunked(context, staging, fiblet_fiber_, bytes.fiblet_fiber, bytesOf(source.tables.fiblet_fiber.data()),
                   progress);
-    uploadChunked(context, staging, fiber_length_, source.fiber_length_mm.data(), bytes.fiber_length, progress);
-    uploadChunked(context, staging, block_buffer_, &block_, bytes.block, progress);
+    uploadChunked(context, staging, directions_, bytes.directions, bytesOf(table.data()), progress);
+    uploadChunked(context, staging, fiber_first_fiblet_, bytes.fiber_first_fiblet, bytesOf(source.tables.first.data()),
+                  progress);
+    uploadChunked(context, staging, fiber_length_, bytes.fiber_length, bytesOf(source.fiber_length_mm.data()), progress);
+    uploadChunked(context, staging, block_buffer_, bytes.block, bytesOf(&block_), progress);
   } catch (...) {
     gpu::destroyBuffer(context, staging);
     throw;

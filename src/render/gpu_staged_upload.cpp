@@ -1,0 +1,42 @@
+#include "render/gpu_staged_upload.h"
+
+#include <algorithm>
+#include <cstring>
+
+#include "gpu/submit.h"
+#include "gpu/vk_check.h"
+
+namespace fibscope {
+
+ChunkSource bytesOf(const void* data) {
+  return [data](uint8_t* out, uint64_t offset, uint64_t bytes) {
+    std::memcpy(out, static_cast<const uint8_t*>(data) + offset, size_t(bytes));
+  };
+}
+
+void uploadChunked(const gpu::VulkanContext& context, const gpu::Buffer& staging, const gpu::Buffer& destination,
+                   uint64_t bytes, const ChunkSource& source, Progress* progress) {
+  for (uint64_t offset = 0; offset < bytes;) {
+    const uint64_t chunk = std::min<uint64_t>(staging.size, bytes - offset);
+    source(static_cast<uint8_t*>(staging.mapped), offset, chunk);
+    if (!staging.coherent) {
+      VkMappedMemoryRange range{VK_STRUCTURE_TYPE_MAPPED_MEMORY_RANGE};
+      range.memory = staging.memory;
+      range.size = VK_WHOLE_SIZE;
+      VK_CHECK(vkFlushMappedMemoryRanges(context.device(), 1, &range));
+    }
+    gpu::submitOnce(context, [&](VkCommandBuffer cmd) {
+      const VkBufferCopy copy{0, offset, chunk};
+      vkCmdCopyBuffer(cmd, staging.buffer, destination.buffer, 1, &copy);
+      // The fence orders the host only: make the copy visible to every
+      // later command on the queue (compute, vertex pulling, indirect reads).
+      gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                         VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                         VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT);
+    });
+    offset += chunk;
+    if (progress) progress->add(double(chunk));
+  }
+}
+
+}  // namespace fibscope

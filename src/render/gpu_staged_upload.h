@@ -1,0 +1,30 @@
+// Filling device-local buffers through one bounded, host-visible staging
+// buffer (a 10 GB section needs no 10 GB of host-visible memory): shared
+// by the fiblet and the raw-vertex uploads.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+
+#include "core/progress.h"
+#include "gpu/buffer.h"
+#include "gpu/vulkan_context.h"
+
+namespace fibscope {
+
+// Writes `bytes` bytes starting at byte `offset` of the buffer's contents
+// to `out` (chunks come in increasing order, back to back), so contents can
+// be generated chunk by chunk instead of held whole in memory.
+using ChunkSource = std::function<void(uint8_t* out, uint64_t offset, uint64_t bytes)>;
+
+// A ChunkSource copying from `data` (which must outlive the upload).
+ChunkSource bytesOf(const void* data);
+
+// Copies `bytes` bytes produced by `source` to the start of `destination`
+// through `staging` (an Upload buffer), one staging-full at a time, each
+// copy submitted and waited for, and made visible to every later command on
+// the queue. `progress` (optional) counts the bytes.
+void uploadChunked(const gpu::VulkanContext& context, const gpu::Buffer& staging, const gpu::Buffer& destination,
+                   uint64_t bytes, const ChunkSource& source, Progress* progress);
+
+}  // namespace fibscope
