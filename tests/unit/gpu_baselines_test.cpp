@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "gpu_render_test_support.h"
 #include "gpu_test_context.h"
 #include "io/reader.h"
 #include "phantom/phantom.h"
@@ -31,34 +32,9 @@
 namespace fibscope {
 namespace {
 
-Tractogram phantom(uint64_t streamlines, uint64_t seed) {
-  PhantomOptions options;
-  options.streamlines = streamlines;
-  options.step_mm = 0.1;
-  options.seed = seed;
-  options.threads = 1;
-  return readAllStreamlines(*openPhantom(options));
-}
-
-std::vector<uint8_t> gbufferMask(const std::vector<shader::GBufferTexel>& texels) {
-  std::vector<uint8_t> mask(texels.size());
-  for (size_t i = 0; i < texels.size(); ++i) mask[i] = texels[i].fiber != shader::kNoFiberId ? 1 : 0;
-  return mask;
-}
-
-// glsl/tangent.glsl's unpackTangent.
-std::array<float, 3> unpackTangent(uint32_t packed) {
-  const auto snorm = [](uint32_t bits) { return std::clamp(float(int16_t(uint16_t(bits))) / 32767.0f, -1.0f, 1.0f); };
-  float x = snorm(packed & 0xFFFFu), y = snorm(packed >> 16);
-  const float z = 1.0f - std::fabs(x) - std::fabs(y);
-  if (z < 0.0f) {
-    const float ox = x;
-    x = (1.0f - std::fabs(y)) * (ox >= 0.0f ? 1.0f : -1.0f);
-    y = (1.0f - std::fabs(ox)) * (y >= 0.0f ? 1.0f : -1.0f);
-  }
-  const float l = std::sqrt(x * x + y * y + z * z);
-  return {x / l, y / l, z / l};
-}
+using test::gbufferMask;
+using test::renderPhantom;
+using test::unpackTangent;
 
 // Orientation shading of a G-buffer, for looking at the images.
 void writeGBufferPng(const std::string& path, uint32_t width, uint32_t height,
@@ -113,7 +89,7 @@ class GpuBaselines : public test::GpuTest {
   void SetUp() override {
     test::GpuTest::SetUp();
     if (IsSkipped()) return;
-    fibers_ = phantom(400, 5);
+    fibers_ = renderPhantom(400, 5);
     const Bounds bounds = tractogramBounds(fibers_);
     views_ = {{"sagittal", standardView(bounds, StandardView::Sagittal, kSize, kSize)},
               {"coronal", standardView(bounds, StandardView::Coronal, kSize, kSize)},
@@ -343,7 +319,7 @@ TEST_F(GpuBaselines, aPipelineWithoutItsInputIsRefused) {
 }
 
 TEST_F(GpuBaselines, anOversizeUploadFailsInOneLineBeforeAllocating) {
-  const Tractogram t = phantom(20, 3);
+  const Tractogram t = renderPhantom(20, 3);
   DeviceLimits small;
   small.device_name = "tinygpu";
   small.device_local_heap_bytes = 16 << 10;

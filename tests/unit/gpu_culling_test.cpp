@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "gpu/submit.h"
+#include "gpu_render_test_support.h"
 #include "gpu_test_context.h"
 #include "io/reader.h"
 #include "phantom/phantom.h"
@@ -28,24 +29,12 @@
 namespace fibscope {
 namespace {
 
+using test::gbufferMask;
+using test::renderPhantom;
+
 // Small enough for lavapipe (the raster dominates: about 0.1 s a frame at
 // width 4), large enough for the phantom's bundles to occlude each other.
 constexpr uint32_t kSize = 160;
-
-Tractogram phantom(uint64_t streamlines, uint64_t seed) {
-  PhantomOptions options;
-  options.streamlines = streamlines;
-  options.step_mm = 0.1;
-  options.seed = seed;
-  options.threads = 1;
-  return readAllStreamlines(*openPhantom(options));
-}
-
-std::vector<uint8_t> gbufferMask(const std::vector<shader::GBufferTexel>& texels) {
-  std::vector<uint8_t> mask(texels.size());
-  for (size_t i = 0; i < texels.size(); ++i) mask[i] = texels[i].fiber != shader::kNoFiberId ? 1 : 0;
-  return mask;
-}
 
 // Settings without the shading passes' extras, so frames are cheap.
 RenderSettings plainSettings(CullingMode culling, float lod_pixels, float line_width) {
@@ -95,7 +84,7 @@ class GpuCulling : public test::GpuTest {
   void SetUp() override {
     test::GpuTest::SetUp();
     if (IsSkipped()) return;
-    fibers_ = phantom(600, 11);
+    fibers_ = renderPhantom(600, 11);
     bounds_ = tractogramBounds(fibers_);
     upload_ = std::make_unique<TractogramUpload>(uploadTractogram(context(), fibers_, "phantom"));
   }

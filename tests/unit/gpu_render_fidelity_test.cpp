@@ -15,6 +15,7 @@
 #include "codec/codec_params.h"
 #include "codec/fiblet_encoder.h"
 #include "gpu/submit.h"
+#include "gpu_render_test_support.h"
 #include "gpu_test_context.h"
 #include "io/reader.h"
 #include "phantom/phantom.h"
@@ -28,39 +29,14 @@
 namespace fibscope {
 namespace {
 
-Tractogram phantom(uint64_t streamlines, uint64_t seed) {
-  PhantomOptions options;
-  options.streamlines = streamlines;
-  options.step_mm = 0.1;
-  options.seed = seed;
-  options.threads = 1;
-  return readAllStreamlines(*openPhantom(options));
-}
-
-std::vector<uint8_t> gbufferMask(const std::vector<shader::GBufferTexel>& texels) {
-  std::vector<uint8_t> mask(texels.size());
-  for (size_t i = 0; i < texels.size(); ++i) mask[i] = texels[i].fiber != shader::kNoFiberId ? 1 : 0;
-  return mask;
-}
-
-// glsl/tangent.glsl's unpackTangent: snorm16 x 2, octahedral.
-std::array<double, 3> unpackTangentForTest(uint32_t packed) {
-  auto snorm = [](uint16_t bits) { return std::clamp(double(int16_t(bits)) / 32767.0, -1.0, 1.0); };
-  const double x = snorm(uint16_t(packed & 0xFFFFu)), y = snorm(uint16_t(packed >> 16));
-  std::array<double, 3> t = {x, y, 1.0 - std::fabs(x) - std::fabs(y)};
-  if (t[2] < 0) {
-    const double tx = (1.0 - std::fabs(y)) * (x >= 0 ? 1.0 : -1.0), ty = (1.0 - std::fabs(x)) * (y >= 0 ? 1.0 : -1.0);
-    t[0] = tx;
-    t[1] = ty;
-  }
-  const double n = std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
-  return {t[0] / n, t[1] / n, t[2] / n};
-}
+using test::gbufferMask;
+using test::renderPhantom;
+using test::unpackTangent;
 
 class GpuRenderFidelity : public test::GpuTest {};
 
 TEST_F(GpuRenderFidelity, computePipelineMatchesTheCpuReferenceFromEveryView) {
-  const Tractogram fibers = phantom(400, 5);
+  const Tractogram fibers = renderPhantom(400, 5);
   const TractogramUpload upload = uploadTractogram(context(), fibers, "phantom");
   const Bounds bounds = tractogramBounds(fibers);
   constexpr uint32_t kSize = 200;
@@ -106,7 +82,7 @@ TEST_F(GpuRenderFidelity, computePipelineMatchesTheCpuReferenceFromEveryView) {
 // on NVIDIA, 64 on AMD); every width, with the scan in shared memory or by
 // subgroup shuffles, must draw the same image.
 TEST_F(GpuRenderFidelity, everyRasterWidthMatchesTheReference) {
-  const Tractogram fibers = phantom(300, 21);
+  const Tractogram fibers = renderPhantom(300, 21);
   const TractogramUpload upload = uploadTractogram(context(), fibers, "phantom");
   constexpr uint32_t kSize = 160;
   const Camera camera = orbitCamera(tractogramBounds(fibers), 200, -30, kSize, kSize, 0.7);
@@ -129,37 +105,30 @@ TEST_F(GpuRenderFidelity, everyRasterWidthMatchesTheReference) {
     const uint32_t lanes = variant.lanes;
     SCOPED_TRACE("lanes " + std::to_string(lanes) + (variant.scan == RasterScan::Subgroup ? ", subgroup scan" : ""));
     FibletPasses passes = createFibletPasses(context(), lanes, variant.scan);
-    gpu::submitOnce(context(), [&](VkCommandBuffer cmd) {
-      const shader::CameraBlock block = makeCameraBlock(camera, 2.0f);
-      vkCmdUpdateBuffer(cmd, frame.camera.buffer, 0, sizeof(block), &block);
-      vkCmdFillBuffer(cmd, frame.visibility.buffer, 0, VK_WHOLE_SIZE, 0xFFFFFFFFu);
-      gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                         VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                         VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
-      recordFibletRasterAll(cmd, context(), passes, upload.dataset, frame);
-      gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                         VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT,
-                         VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
-      recordFibletResolve(cmd, passes, upload.dataset, frame);
-    });
-    const std::vector<shader::GBufferTexel> decoded = downloadGBuffer(context(), frame);
+    // Raster + resolve alone (no culling, no shading), as a frame records them.
+    auto drawAndResolve = [&] {
+      gpu::submitOnce(context(), [&](VkCommandBuffer cmd) {
+        const shader::CameraBlock block = makeCameraBlock(camera, 2.0f);
+        vkCmdUpdateBuffer(cmd, frame.camera.buffer, 0, sizeof(block), &block);
+        vkCmdFillBuffer(cmd, frame.visibility.buffer, 0, VK_WHOLE_SIZE, 0xFFFFFFFFu);
+        gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                           VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                           VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+        recordFibletRasterAll(cmd, context(), passes, upload.dataset, frame);
+        gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                           VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT,
+                           VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
+        recordFibletResolve(cmd, passes, upload.dataset, frame);
+      });
+      return downloadGBuffer(context(), frame);
+    };
+    const std::vector<shader::GBufferTexel> decoded = drawAndResolve();
     // The same frame with the tangent cache: the resolve reads the rasters'
     // tangents instead of decoding; the texels must agree (tangents to the
     // packing's precision: computed in world and in normalised space).
     prepareTangentCache(context(), frame, upload.dataset.block().fiblet_count);
     ASSERT_NE(frame.tangents.address, 0u);
-    gpu::submitOnce(context(), [&](VkCommandBuffer cmd) {
-      vkCmdFillBuffer(cmd, frame.visibility.buffer, 0, VK_WHOLE_SIZE, 0xFFFFFFFFu);
-      gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                         VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                         VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
-      recordFibletRasterAll(cmd, context(), passes, upload.dataset, frame);
-      gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                         VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT,
-                         VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
-      recordFibletResolve(cmd, passes, upload.dataset, frame);
-    });
-    const std::vector<shader::GBufferTexel> cached = downloadGBuffer(context(), frame);
+    const std::vector<shader::GBufferTexel> cached = drawAndResolve();
     prepareTangentCache(context(), frame, 0);
     size_t covered = 0, differ = 0;
     for (size_t i = 0; i < decoded.size(); ++i) {
@@ -167,7 +136,7 @@ TEST_F(GpuRenderFidelity, everyRasterWidthMatchesTheReference) {
       ASSERT_EQ(decoded[i].segment, cached[i].segment) << i;
       if (decoded[i].fiber == shader::kNoFiberId) continue;
       ++covered;
-      const auto a = unpackTangentForTest(decoded[i].tangent), b = unpackTangentForTest(cached[i].tangent);
+      const auto a = unpackTangent(decoded[i].tangent), b = unpackTangent(cached[i].tangent);
       differ += std::fabs(a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) < 0.99999;
     }
     EXPECT_EQ(differ, 0u) << "of " << covered << " covered pixels have different tangents";
@@ -188,7 +157,7 @@ TEST_F(GpuRenderFidelity, everyRasterWidthMatchesTheReference) {
 TEST_F(GpuRenderFidelity, onTheFlyUploadEncodesInParallelLikeTheSequentialEncoder) {
   // 700 fibers of ~880 points: three chunks of 2^18 points, so the parts
   // encoded by different workers are joined.
-  const Tractogram fibers = phantom(700, 9);
+  const Tractogram fibers = renderPhantom(700, 9);
   ASSERT_GT(fibers.pointCount(), size_t(2) << 18);
   const TractogramUpload upload = uploadTractogram(context(), fibers, "phantom");
   const EncodedFiblets expected = encodeTractogram(fibers, upload.params);

@@ -1,0 +1,51 @@
+// Helpers shared by the renderer's GPU tests: the test phantom, a G-buffer's
+// coverage mask, and the CPU mirror of glsl/tangent.glsl's unpackTangent.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "core/tractogram.h"
+#include "io/reader.h"
+#include "phantom/phantom.h"
+#include "shared/gbuffer.h"
+#include "shared/render_config.h"
+
+namespace fibscope::test {
+
+// A brain-like phantom at 0.1 mm steps, generated on one thread
+// (deterministic for the seed).
+inline Tractogram renderPhantom(uint64_t streamlines, uint64_t seed) {
+  PhantomOptions options;
+  options.streamlines = streamlines;
+  options.step_mm = 0.1;
+  options.seed = seed;
+  options.threads = 1;
+  return readAllStreamlines(*openPhantom(options));
+}
+
+// 1 where a fiber was drawn (compareCoverage's input).
+inline std::vector<uint8_t> gbufferMask(const std::vector<shader::GBufferTexel>& texels) {
+  std::vector<uint8_t> mask(texels.size());
+  for (size_t i = 0; i < texels.size(); ++i) mask[i] = texels[i].fiber != shader::kNoFiberId ? 1 : 0;
+  return mask;
+}
+
+// glsl/tangent.glsl's unpackTangent: snorm16 x 2, octahedral, normalised.
+inline std::array<float, 3> unpackTangent(uint32_t packed) {
+  const auto snorm = [](uint32_t bits) { return std::clamp(float(int16_t(uint16_t(bits))) / 32767.0f, -1.0f, 1.0f); };
+  float x = snorm(packed & 0xFFFFu), y = snorm(packed >> 16);
+  const float z = 1.0f - std::fabs(x) - std::fabs(y);
+  if (z < 0.0f) {
+    const float ox = x;
+    x = (1.0f - std::fabs(y)) * (ox >= 0.0f ? 1.0f : -1.0f);
+    y = (1.0f - std::fabs(ox)) * (y >= 0.0f ? 1.0f : -1.0f);
+  }
+  const float l = std::sqrt(x * x + y * y + z * z);
+  return {x / l, y / l, z / l};
+}
+
+}  // namespace fibscope::test
