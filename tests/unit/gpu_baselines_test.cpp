@@ -117,6 +117,27 @@ class GpuBaselines : public test::GpuTest {
     writePngRgba(std::string(dir) + "/" + stem + "-diff.png", kSize, kSize, diff);
   }
 
+  // One frame of `settings` from `view`, its G-buffer, the CPU reference at
+  // `width` and their comparison (PNGs with FIBSCOPE_TEST_PNG_DIR).
+  struct Compared {
+    FrameStats stats;
+    std::vector<shader::GBufferTexel> texels;
+    ReferenceFrame reference;
+    CoverageComparison coverage;
+    IdAgreement ids;
+  };
+  Compared renderAndCompare(FrameRenderer& renderer, const RenderSettings& settings, const GpuRawTractogram& raw,
+                            const View& view, float width, const std::string& stem) {
+    Compared r;
+    r.stats = renderer.render(view.camera, settings, GpuScene{nullptr, &raw});
+    r.texels = downloadGBuffer(context(), renderer.targets());
+    r.reference = rasterizeReference(fibers_, view.camera, width);
+    maybeWritePngs(stem + "-" + view.name + "-w" + std::to_string(int(width)), r.texels, r.reference);
+    r.coverage = compareCoverage(gbufferMask(r.texels), r.reference.coverageMask(), kSize, kSize);
+    r.ids = compareIds(r.texels, r.reference);
+    return r;
+  }
+
   Tractogram fibers_;
   std::vector<View> views_;
 };
@@ -130,14 +151,12 @@ TEST_F(GpuBaselines, rawComputeMatchesTheCpuReferenceFromEveryView) {
     settings.line_width_px = width;
     for (const View& view : views_) {
       SCOPED_TRACE(std::string(view.name) + ", width " + std::to_string(width));
-      const FrameStats stats = renderer.render(view.camera, settings, GpuScene{nullptr, &raw});
+      const Compared r = renderAndCompare(renderer, settings, raw, view, width, "raw-compute");
+      const FrameStats& stats = r.stats;
+      const CoverageComparison& c = r.coverage;
+      const IdAgreement& ids = r.ids;
       EXPECT_EQ(stats.segments_total, raw.segmentCount());
-      const auto texels = downloadGBuffer(context(), renderer.targets());
-      const ReferenceFrame reference = rasterizeReference(fibers_, view.camera, width);
-      maybeWritePngs(std::string("raw-compute-") + view.name + "-w" + std::to_string(int(width)), texels, reference);
-      const CoverageComparison c = compareCoverage(gbufferMask(texels), reference.coverageMask(), kSize, kSize);
       ASSERT_GT(c.covered_b, kSize * kSize / 20) << "the view shows the phantom: " << c.summary();
-      const IdAgreement ids = compareIds(texels, reference);
       std::printf(
           "[ GPU      ] raw-compute %s w%.0f: %s; same fiber %zu, segment %zu, tangent %zu of %zu, depth error %.2g; "
           "%.2f ms\n",
@@ -167,14 +186,12 @@ TEST_F(GpuBaselines, linesCoverTheCpuReferenceToAboutAPixel) {
     settings.line_width_px = requested;
     for (const View& view : views_) {
       SCOPED_TRACE(std::string(view.name) + ", width " + std::to_string(width));
-      const FrameStats stats = renderer.render(view.camera, settings, GpuScene{nullptr, &raw});
+      const Compared r = renderAndCompare(renderer, settings, raw, view, width, "lines");
+      const FrameStats& stats = r.stats;
+      const CoverageComparison& c = r.coverage;
+      const IdAgreement& ids = r.ids;
       EXPECT_EQ(stats.segments_total, raw.segmentCount());
-      const auto texels = downloadGBuffer(context(), renderer.targets());
-      const ReferenceFrame reference = rasterizeReference(fibers_, view.camera, width);
-      maybeWritePngs(std::string("lines-") + view.name + "-w" + std::to_string(int(width)), texels, reference);
-      const CoverageComparison c = compareCoverage(gbufferMask(texels), reference.coverageMask(), kSize, kSize);
       ASSERT_GT(c.covered_b, kSize * kSize / 20) << "the view shows the phantom: " << c.summary();
-      const IdAgreement ids = compareIds(texels, reference);
       std::printf(
           "[ GPU      ] lines %s w%.0f: %s; of %zu both: same fiber %zu (segment within 8: %zu, same %zu, depth error "
           "%.2g), other fiber %zu (%zu of them nearer in the reference); %.2f ms\n",
@@ -201,7 +218,7 @@ TEST_F(GpuBaselines, linesCoverTheCpuReferenceToAboutAPixel) {
       // Same segment: the same line, so the same interpolated depth.
       EXPECT_LE(ids.max_depth_error, 1e-4);
       // Empty texels are exactly the clear value.
-      for (const shader::GBufferTexel& t : texels) {
+      for (const shader::GBufferTexel& t : r.texels) {
         if (t.fiber != shader::kNoFiberId) continue;
         ASSERT_EQ(t.depth, 1.0f);
         ASSERT_EQ(t.segment, 0u);
