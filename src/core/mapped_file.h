@@ -37,10 +37,4 @@ class MappedFile {
   size_t size_ = 0;
 };
 
-// Asks the kernel to back the whole 2 MiB pages inside [data, data + bytes)
-// of an anonymous allocation with transparent huge pages (madvise
-// MADV_HUGEPAGE): for large buffers filled once, one page fault per 2 MiB
-// instead of per 4 KiB. Best effort: does nothing where unsupported.
-void adviseHugePages(void* data, size_t bytes);
-
 }  // namespace fibscope

@@ -2,7 +2,7 @@
 
 #include <cstring>
 
-#include "core/mapped_file.h"
+#include "core/huge_pages.h"
 #include "gpu/submit.h"
 #include "gpu/vk_check.h"
 

@@ -3,7 +3,7 @@
 #include <filesystem>
 
 #include "core/error.h"
-#include "core/mapped_file.h"
+#include "core/huge_pages.h"
 #include "io/reader.h"
 #include "io/writer.h"
 
