@@ -167,10 +167,12 @@ void runBench(const BenchOptions& o) {
   out["streamlines"] = scene.streamlines;
   out["segments"] = scene.segments;
   out["fiblets"] = scene.fiblets.block().fiblet_count;
-  // Ratios compare GPU time, except on a CPU device (lavapipe): there some
-  // timestamps around large dispatches (2-D grids) were seen to read close
-  // to zero while the frame took seconds, so wall time (submit to fence,
-  // one frame per submission, the CPU doing all the work) is the figure.
+  // Ratios compare GPU time, except on a CPU device (lavapipe): there the
+  // timestamps around the passes of a large dataset (34 M segments, 2-D
+  // grids of 82 k and more workgroups) were seen to read close to zero
+  // while the frame took seconds (cause not found; a 20 M-segment dataset
+  // with 1-D grids timed right), so wall time (submit to fence, one frame
+  // per submission, the CPU doing all the work) is the figure.
   const bool cpu_device = context->info().type == VK_PHYSICAL_DEVICE_TYPE_CPU;
   auto ratioTime = [&](const Variant& v) { return percentile(cpu_device ? v.wall_ms : v.gpu_ms, 50); };
   const double base_median = ratioTime(variants.front());
