@@ -64,4 +64,11 @@ void memoryBarrier(VkCommandBuffer cmd, VkPipelineStageFlags2 src_stage, VkAcces
   vkCmdPipelineBarrier2(cmd, &dependency);
 }
 
+void computeToComputeBarrier(VkCommandBuffer cmd) {
+  memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT,
+                VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+}
+
 }  // namespace fibscope::gpu

@@ -19,5 +19,8 @@ void submitOnce(const VulkanContext& context, const std::function<void(VkCommand
 // A memory barrier between two passes (synchronization2).
 void memoryBarrier(VkCommandBuffer cmd, VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
                    VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access);
+// The barrier between two compute passes: every storage write and read of
+// the earlier ones before any storage read or write of the later ones.
+void computeToComputeBarrier(VkCommandBuffer cmd);
 
 }  // namespace fibscope::gpu

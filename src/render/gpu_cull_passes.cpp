@@ -14,15 +14,6 @@ namespace {
 constexpr VkDeviceSize kCountOffset = offsetof(shader::FibletListHeader, count);
 constexpr uint32_t kLodItemsPerGroup = 64;  // fiblet_lod_raster.comp's local size
 
-// Compute writes (cull, finalize, raster, pyramid) visible to the next
-// compute pass.
-void computeToCompute(VkCommandBuffer cmd) {
-  gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                     VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT,
-                     VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                     VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
-}
-
 // Finalised lists to the indirect dispatch and the rasters' reads.
 void computeToIndirect(VkCommandBuffer cmd) {
   gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
@@ -112,7 +103,7 @@ void recordPhase(VkCommandBuffer cmd, const gpu::VulkanContext& context, const C
   resetLists(cmd, buffers);
   transferToCompute(cmd);
   recordCull(cmd, context, passes, dataset, frame, buffers, mode, cull);
-  computeToCompute(cmd);
+  gpu::computeToComputeBarrier(cmd);
   recordFinalize(cmd, context, passes, buffers, fiblet_passes);
   gpu::endPass(cmd, timer);
   computeToIndirect(cmd);
@@ -205,7 +196,7 @@ void recordDepthPyramid(VkCommandBuffer cmd, const CullPasses& passes, const Gpu
   push.height = frame.height;
   const uint32_t levels = shader::pyramidLevelCount(frame.width, frame.height);
   for (uint32_t level = 0; level < levels; ++level) {
-    if (level > 0) computeToCompute(cmd);
+    if (level > 0) gpu::computeToComputeBarrier(cmd);
     push.level = level;
     const uint32_t w = shader::pyramidLevelSize(frame.width, level);
     const uint32_t h = shader::pyramidLevelSize(frame.height, level);
@@ -235,7 +226,7 @@ void recordCulledRaster(VkCommandBuffer cmd, const gpu::VulkanContext& context, 
   if (two_phase) {
     // The phase-1 raster's writes to the pyramid; its reads of the lists
     // before their counts are copied and reset.
-    computeToCompute(cmd);
+    gpu::computeToComputeBarrier(cmd);
     computeToTransfer(cmd);
     gpu::beginPass(cmd, timer, "depth pyramid");
     copyCounts(cmd, buffers, 0);
@@ -243,7 +234,7 @@ void recordCulledRaster(VkCommandBuffer cmd, const gpu::VulkanContext& context, 
     gpu::endPass(cmd, timer);
     // The copies read the counts before recordPhase's reset writes them.
     gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, 0, VK_PIPELINE_STAGE_2_TRANSFER_BIT, 0);
-    computeToCompute(cmd);
+    gpu::computeToComputeBarrier(cmd);
     recordPhase(cmd, context, passes, fiblet_passes, dataset, frame, buffers, shader::kCullPhase2, cull, timer,
                 "cull 2", "raster 2");
   }

@@ -9,14 +9,6 @@
 namespace fibscope {
 namespace {
 
-// Compute writes by one pass made visible to compute reads of the next.
-void computeToCompute(VkCommandBuffer cmd) {
-  gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                     VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT,
-                     VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                     VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
-}
-
 constexpr uint32_t kMaxPassesPerFrame = 16;
 
 }  // namespace
@@ -113,12 +105,12 @@ void FrameRenderer::record(VkCommandBuffer cmd, const Camera& camera, const Rend
     gpu::beginPass(cmd, timer_, "raster");
     recordRawRaster(cmd, context_, raw_passes_, *scene.raw, targets_);
     gpu::endPass(cmd, timer_);
-    computeToCompute(cmd);
+    gpu::computeToComputeBarrier(cmd);
 
     gpu::beginPass(cmd, timer_, "resolve");
     recordRawResolve(cmd, raw_passes_, *scene.raw, targets_);
     gpu::endPass(cmd, timer_);
-    computeToCompute(cmd);
+    gpu::computeToComputeBarrier(cmd);
   } else {
     const GpuDataset& dataset = *scene.fiblets;
     pending_.fiblets_total = dataset.block().fiblet_count;
@@ -139,12 +131,12 @@ void FrameRenderer::record(VkCommandBuffer cmd, const Camera& camera, const Rend
       pending_.fiblets_drawn = pending_.fiblets_total;
       cull_buffers_.history_valid = false;  // two-phase history skips this frame
     }
-    computeToCompute(cmd);
+    gpu::computeToComputeBarrier(cmd);
 
     gpu::beginPass(cmd, timer_, "resolve");
     recordFibletResolve(cmd, fiblet_passes_, dataset, targets_);
     gpu::endPass(cmd, timer_);
-    computeToCompute(cmd);
+    gpu::computeToComputeBarrier(cmd);
   }
 
   recordShade(cmd, shade_pass_, targets_, settings, &timer_);

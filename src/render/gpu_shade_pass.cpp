@@ -19,12 +19,6 @@ constexpr float kSsaoEpsilonMm = 0.3f;
 constexpr float kSsaoBlurDepthToleranceMm = 1.0f;
 constexpr float kMaxSsaoRadiusPx = 64.0f;
 
-void computeToCompute(VkCommandBuffer cmd) {
-  gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                     VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                     VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
-}
-
 void begin(VkCommandBuffer cmd, gpu::GpuTimer* timer, const char* name) {
   if (timer) gpu::beginPass(cmd, *timer, name);
 }
@@ -119,7 +113,7 @@ void recordShade(VkCommandBuffer cmd, const ShadePass& pass, const GpuFrameTarge
     begin(cmd, timer, "ssao");
     gpu::recordDispatch(cmd, pass.ssao, push, groups_x, groups_y);
     end(cmd, timer);
-    computeToCompute(cmd);
+    gpu::computeToComputeBarrier(cmd);
 
     shader::SsaoBlurPush blur{};
     blur.camera = frame.camera.address;
@@ -133,14 +127,14 @@ void recordShade(VkCommandBuffer cmd, const ShadePass& pass, const GpuFrameTarge
     blur.step_x = 1;
     blur.step_y = 0;
     gpu::recordDispatch(cmd, pass.ssao_blur, blur, groups_x, groups_y);
-    computeToCompute(cmd);
+    gpu::computeToComputeBarrier(cmd);
     blur.ao_in = pass.ao_blur.address;
     blur.ao_out = pass.ao.address;
     blur.step_x = 0;
     blur.step_y = 1;
     gpu::recordDispatch(cmd, pass.ssao_blur, blur, groups_x, groups_y);
     end(cmd, timer);
-    computeToCompute(cmd);
+    gpu::computeToComputeBarrier(cmd);
   }
 
   shader::ShadePush push{};
