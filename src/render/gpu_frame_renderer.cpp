@@ -53,6 +53,7 @@ void FrameRenderer::resize(uint32_t width, uint32_t height) {
   }
   destroyFrameTargets(context_, targets_);
   targets_ = fresh;
+  tangent_cache_for_ = 0;  // the fresh targets have no tangent cache
 }
 
 void FrameRenderer::record(VkCommandBuffer cmd, const Camera& camera, const RenderSettings& settings,
@@ -115,8 +116,12 @@ void FrameRenderer::record(VkCommandBuffer cmd, const Camera& camera, const Rend
     const GpuDataset& dataset = *scene.fiblets;
     pending_.fiblets_total = dataset.block().fiblet_count;
     // The rasters keep each drawn segment's tangent so the resolve need
-    // not decode again (when the dataset's cache fits the budget).
-    prepareTangentCache(context_, targets_, dataset.block().fiblet_count);
+    // not decode again (when the dataset's cache fits the budget): sized
+    // once per dataset, not per frame.
+    if (tangent_cache_for_ != dataset.blockAddress()) {
+      prepareTangentCache(context_, targets_, dataset.block().fiblet_count);
+      tangent_cache_for_ = dataset.blockAddress();
+    }
     cull_stats_pending_ = settings.culling != CullingMode::None && pending_.fiblets_total > 0;
     if (cull_stats_pending_) {
       // Cull passes, both rasters (and the pyramid and second phase for

@@ -65,6 +65,8 @@ class FrameRenderer {
   CullPasses cull_passes_;
   CullBuffers cull_buffers_;  // lists, pyramid and the two-phase visible bits (kept across frames)
   bool cull_stats_pending_ = false;  // the last frame was culled: collect() reads its counts
+  // The dataset (its block's address) targets_.tangents was sized for.
+  VkDeviceAddress tangent_cache_for_ = 0;
   RawPasses raw_passes_;
   LinesPass lines_pass_;  // created at the first lines frame
   ShadePass shade_pass_;

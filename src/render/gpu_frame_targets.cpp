@@ -4,6 +4,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "render/gpu_dataset.h"
 
 namespace fibscope {
 
@@ -41,29 +42,19 @@ void destroyFrameTargets(const gpu::VulkanContext& context, GpuFrameTargets& tar
 
 void prepareTangentCache(const gpu::VulkanContext& context, GpuFrameTargets& targets, uint32_t fiblets) {
   const uint64_t bytes = uint64_t(fiblets) * 64 * sizeof(uint32_t);
-  uint64_t heap = 0;
-  const VkPhysicalDeviceMemoryProperties& memory = context.memoryProperties();
-  for (uint32_t i = 0; i < memory.memoryHeapCount; ++i)
-    if (memory.memoryHeaps[i].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT) heap = std::max(heap, memory.memoryHeaps[i].size);
-  const uint64_t budget = std::min({kTangentCacheBudget, heap / 4, uint64_t(context.info().max_memory_allocation_size)});
-  if (fiblets == 0 || bytes > budget) {
-    if (targets.tangents.buffer) {
-      vkDeviceWaitIdle(context.device());
-      gpu::destroyBuffer(context, targets.tangents);
-    }
-    targets.tangent_fiblets = 0;
-    return;
-  }
-  targets.tangent_fiblets = fiblets;
-  if (targets.tangents.size >= bytes) return;
+  const DeviceLimits limits = deviceLimits(context);
+  const uint64_t budget = std::min({kTangentCacheBudget, limits.device_local_heap_bytes / 4, limits.max_allocation_bytes});
+  const bool wanted = fiblets > 0 && bytes <= budget;
+  if (wanted && targets.tangents.size >= bytes) return;  // the buffer already holds it
   if (targets.tangents.buffer) {
-    vkDeviceWaitIdle(context.device());
+    vkDeviceWaitIdle(context.device());  // earlier frames may still write it
     gpu::destroyBuffer(context, targets.tangents);
   }
+  if (!wanted) return;
   try {
     targets.tangents = gpu::createBuffer(context, bytes, gpu::MemoryUse::DeviceLocal);
   } catch (const Error&) {
-    targets.tangent_fiblets = 0;  // out of memory: resolve by decoding
+    // Out of memory: no cache (address 0), the resolve decodes.
   }
 }
 

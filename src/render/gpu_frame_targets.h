@@ -25,7 +25,6 @@ struct GpuFrameTargets {
   // fiblet rasters draw, a uint at fiblet * 64 + segment, so the resolve
   // reads it instead of decoding the fiblet again per pixel (render_push.h).
   gpu::Buffer tangents;
-  uint32_t tangent_fiblets = 0;  // fiblets the cache holds
   uint64_t pixels() const { return uint64_t(width) * height; }
 };
 
