@@ -121,7 +121,8 @@ void FrameRenderer::record(VkCommandBuffer cmd, const Camera& camera, const Rend
     // (A cache smaller than the dataset is never used: a new dataset may
     // reuse a destroyed one's address.)
     const uint64_t cache_bytes = uint64_t(dataset.block().fiblet_count) * 64 * sizeof(uint32_t);
-    if (tangent_cache_for_ != dataset.blockAddress() || (targets_.tangents.buffer && targets_.tangents.size < cache_bytes)) {
+    if (tangent_cache_for_ != dataset.blockAddress() ||
+        (targets_.tangents.buffer && targets_.tangents.size < cache_bytes)) {
       prepareTangentCache(context_, targets_, dataset.block().fiblet_count);
       tangent_cache_for_ = dataset.blockAddress();
     }
