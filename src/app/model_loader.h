@@ -38,6 +38,8 @@
 
 namespace fibscope {
 
+class FblCache;
+
 struct ModelLoaderOptions {
   uint64_t phantom_streamlines = 10000;  // the built-in phantom (request(""))
   uint64_t phantom_seed = 1;
@@ -122,10 +124,10 @@ class ModelLoader {
     std::string path;
   };
   void run();
-  LoadEvent load(const Job& job);
-  void finishEvent(LoadEvent event);
+  LoadEvent load(const Job& job, const std::atomic<bool>& cancel);
 
   ModelLoaderOptions options_;
+  std::unique_ptr<FblCache> cache_;  // one for the loader's life (warns once when unwritable)
   mutable std::mutex mutex_;
   std::condition_variable wake_;      // worker: a job queued or stop
   std::condition_variable finished_;  // wait(): an event
@@ -143,9 +145,11 @@ class ModelLoader {
 // The job's work without a thread (the loader's worker calls it): loads
 // `path` ("" = phantom) as described above. Throws Error on failure; a set
 // `cancel` flag throws Error("<path>: cancelled"). `progress_sink` receives
-// the snapshots.
+// the snapshots. `cache` null: a cache from the options (or none when
+// !use_cache).
 ModelData loadModel(const std::string& path, const ModelLoaderOptions& options,
-                    const std::atomic<bool>* cancel = nullptr, const Progress::Sink& progress_sink = {});
+                    const std::atomic<bool>* cancel = nullptr, const Progress::Sink& progress_sink = {},
+                    FblCache* cache = nullptr);
 
 // Bounds of every point and about `sample_count` sample points of an opened
 // .fbl, in world mm (decodes the fiblets near the box's faces and a spread

@@ -143,8 +143,12 @@ class FblCache {
   uint64_t evict(const std::string& keep = {});
 
  private:
+  // The verified entry for `key`, or nothing (a damaged one is deleted).
+  std::optional<FblFile> openEntry(const FblCacheKey& key, std::vector<std::string>* warnings);
   FblCacheEntry compressTemporary(const ReaderFactory& open_input, const CompressOptions& options,
-                                  const std::string& reason);
+                                  const std::string& reason, std::vector<std::string> warnings);
+  // Deletes the entries of other versions of key's file.
+  void removeSuperseded(const FblCacheKey& key);
   std::string dir_;
   uint64_t max_bytes_;
   bool warned_unwritable_ = false;
