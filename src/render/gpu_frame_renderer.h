@@ -31,6 +31,12 @@ namespace fibscope {
 struct GpuScene {
   const GpuDataset* fiblets = nullptr;
   const GpuRawTractogram* raw = nullptr;  // lines and raw-compute
+  // Per-fiber attributes (src/render/gpu_fiber_attributes.h), indexed by
+  // the G-buffer's fiber id; 0 means none. Each must hold an entry for
+  // every fiber of the drawn tractogram.
+  VkDeviceAddress fiber_scalars = 0;   // float per fiber (ColorMode::Scalar), e.g. GpuDataset::fiberLength()
+  VkDeviceAddress selection_bits = 0;  // uint words: fiber f selected when bit f % 32 of word f / 32 is set;
+                                       // 0 also means an empty selection (nothing dimmed)
 };
 
 class FrameRenderer {

@@ -148,6 +148,8 @@ void recordShade(VkCommandBuffer cmd, const ShadePass& pass, const GpuFrameTarge
     case ColorMode::Solid: push.color_mode = shader::kShadeColorSolid; break;
     case ColorMode::Orientation: push.color_mode = shader::kShadeColorOrientation; break;
     case ColorMode::PerFiber: push.color_mode = shader::kShadeColorPerFiber; break;
+    case ColorMode::Scalar:
+    case ColorMode::Normal: push.color_mode = shader::kShadeColorOrientation; break;  // shaded next commit
   }
   push.lighting = settings.lighting == Lighting::IlluminatedLines ? shader::kShadeLightingIlluminated
                                                                   : shader::kShadeLightingNone;

@@ -29,9 +29,14 @@ constexpr std::pair<std::string_view, RenderPipeline> kPipelines[] = {
 constexpr std::pair<std::string_view, CullingMode> kCulling[] = {
     {"none", CullingMode::None}, {"frustum", CullingMode::Frustum}, {"two-phase", CullingMode::TwoPhase}};
 constexpr std::pair<std::string_view, ColorMode> kColors[] = {
-    {"solid", ColorMode::Solid}, {"orientation", ColorMode::Orientation}, {"fiber", ColorMode::PerFiber}};
+    {"solid", ColorMode::Solid}, {"orientation", ColorMode::Orientation}, {"fiber", ColorMode::PerFiber},
+    {"scalar", ColorMode::Scalar}, {"normal", ColorMode::Normal}};
 constexpr std::pair<std::string_view, Lighting> kLighting[] = {
     {"none", Lighting::None}, {"illuminated", Lighting::IlluminatedLines}};
+constexpr std::pair<std::string_view, Colormap> kColormaps[] = {{"viridis", Colormap::Viridis},
+                                                                {"magma", Colormap::Magma},
+                                                                {"grayscale", Colormap::Grayscale},
+                                                                {"coolwarm", Colormap::CoolWarm}};
 
 }  // namespace
 
@@ -39,9 +44,11 @@ RenderPipeline parseRenderPipeline(std::string_view name) { return parseName("pi
 CullingMode parseCullingMode(std::string_view name) { return parseName("culling", name, kCulling); }
 ColorMode parseColorMode(std::string_view name) { return parseName("color", name, kColors); }
 Lighting parseLighting(std::string_view name) { return parseName("lighting", name, kLighting); }
+Colormap parseColormap(std::string_view name) { return parseName("colormap", name, kColormaps); }
 std::string_view renderPipelineName(RenderPipeline pipeline) { return nameOf(pipeline, kPipelines); }
 std::string_view cullingModeName(CullingMode mode) { return nameOf(mode, kCulling); }
 std::string_view colorModeName(ColorMode mode) { return nameOf(mode, kColors); }
 std::string_view lightingName(Lighting lighting) { return nameOf(lighting, kLighting); }
+std::string_view colormapName(Colormap colormap) { return nameOf(colormap, kColormaps); }
 
 }  // namespace fibscope

@@ -29,6 +29,25 @@ enum class ColorMode : uint8_t {
   Solid,        // RenderSettings::solid_color
   Orientation,  // |tangent| as RGB (world axes: x red, y green, z blue)
   PerFiber,     // a distinct colour per fiber (hashed from its index)
+  // A float per fiber (GpuScene::fiber_scalars, e.g. the fiber lengths)
+  // through `colormap` over [scalar_min, scalar_max], clamped. Without
+  // scalars (address 0) the frame falls back to Orientation: a viewer that
+  // has not loaded them yet still draws.
+  Scalar,
+  // The view-facing line normal N = normalize(V - (V.T) T) (V towards the
+  // eye, T the tangent) in view space as RGB 0.5 + 0.5 N (x right, y up,
+  // z towards the viewer): FiberVisualizer's normal colouring for lines. A
+  // line seen end-on (T parallel to V) faces the viewer: N = V.
+  Normal,
+};
+
+// Colormaps of ColorMode::Scalar: 256-entry tables interpolated from a few
+// control points (src/render/colormap.h).
+enum class Colormap : uint8_t {
+  Viridis,    // matplotlib's perceptually uniform default (van der Walt, Smith)
+  Magma,      // matplotlib's black -> purple -> orange -> pale yellow
+  Grayscale,  // black -> white
+  CoolWarm,   // Moreland's diverging blue -> grey -> red (2009)
 };
 
 enum class Lighting : uint8_t {
@@ -43,6 +62,18 @@ struct RenderSettings {
   float line_width_px = 1.0f;  // [1, 4]
   ColorMode color = ColorMode::Orientation;
   std::array<float, 3> solid_color = {0.9f, 0.9f, 0.85f};
+  // ColorMode::Scalar: the colormap and the scalar range mapped onto it
+  // (values outside are clamped; scalar_max >= scalar_min, equal maps every
+  // fiber to the middle of the colormap).
+  Colormap colormap = Colormap::Viridis;
+  float scalar_min = 0.0f;
+  float scalar_max = 1.0f;
+  // Selection (GpuScene::selection_bits): selected fibers take
+  // highlight_color as their base colour (still lit, so they read as
+  // lines); unselected ones fade towards the background by dim_unselected
+  // in [0, 1] (0: unchanged, 1: invisible). No effect without a selection.
+  std::array<float, 3> highlight_color = {1.0f, 0.8f, 0.1f};
+  float dim_unselected = 0.7f;
   Lighting lighting = Lighting::IlluminatedLines;
   // Illuminated lines: colour = base * (ambient + diffuse * D) + specular * S^shininess
   // (shaders/shared/shade_push.h).
@@ -57,6 +88,14 @@ struct RenderSettings {
   // bundle far in front of another casts no shadow on it, one lying on it
   // (bundles are about 10 mm thick) does.
   float ssao_range_mm = 10.0f;
+  // Multi-scale ambient occlusion (FiberVisualizer): 1 is plain SSAO; 2 to
+  // 4 also sample at 2, 4, 8 times ssao_radius_px, and the per-scale
+  // occlusion factors multiply, so near contacts and whole bundles both
+  // darken.
+  int ao_scales = 1;
+  // FXAA (Lottes' fast approximate anti-aliasing, 3.11 quality-like) over
+  // the shaded RGBA8 image: smooths the stair steps of 1-pixel lines.
+  bool fxaa = false;
   std::array<float, 3> background = {0.0f, 0.0f, 0.0f};
 };
 
@@ -66,10 +105,12 @@ RenderPipeline parseRenderPipeline(std::string_view name);
 CullingMode parseCullingMode(std::string_view name);
 ColorMode parseColorMode(std::string_view name);
 Lighting parseLighting(std::string_view name);
+Colormap parseColormap(std::string_view name);
 std::string_view renderPipelineName(RenderPipeline pipeline);
 std::string_view cullingModeName(CullingMode mode);
 std::string_view colorModeName(ColorMode mode);
 std::string_view lightingName(Lighting lighting);
+std::string_view colormapName(Colormap colormap);
 
 // GPU time of one pass of a frame.
 struct PassTiming {

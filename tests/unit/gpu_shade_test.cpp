@@ -139,6 +139,7 @@ Rgb expectedColor(const Camera& camera, const RenderSettings& s, const Texel& t)
       base = {std::fabs(tangent[0]), std::fabs(tangent[1]), std::fabs(tangent[2])};
       break;
     case ColorMode::PerFiber: base = expectedFiberColor(t.fiber); break;
+    default: ADD_FAILURE() << "no reference for " << colorModeName(s.color); break;
   }
   if (s.lighting == Lighting::None) return base;
   // World position of the pixel centre at its depth, through the inverse
