@@ -130,12 +130,13 @@ class OrbitController {
 };
 
 // Quaternion helpers (exposed for the tests).
-Quat normalize(const Quat& q);
-Quat multiply(const Quat& a, const Quat& b);  // a then applied after b: rotate(a*b, v) = rotate(a, rotate(b, v))
-Vec3d rotate(const Quat& q, const Vec3d& v);
-Quat axisAngle(const Vec3d& unit_axis, double radians);
+Quat quatNormalize(const Quat& q);
+// a * b: quatRotate(a * b, v) == quatRotate(a, quatRotate(b, v)).
+Quat quatMultiply(const Quat& a, const Quat& b);
+Vec3d quatRotate(const Quat& q, const Vec3d& v);
+Quat quatAxisAngle(const Vec3d& unit_axis, double radians);
 // Shortest-path spherical interpolation, t in [0, 1].
-Quat slerp(const Quat& a, const Quat& b, double t);
+Quat quatSlerp(const Quat& a, const Quat& b, double t);
 // The orientation whose local +x, +y, +z are the given orthonormal right-handed axes.
 Quat quatFromAxes(const Vec3d& right, const Vec3d& up, const Vec3d& back);
 
