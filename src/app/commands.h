@@ -17,5 +17,6 @@ void addCompressCommand(CLI::App& app);
 void addGpuInfoCommand(CLI::App& app);
 void addRenderCommand(CLI::App& app);
 void addBenchCommand(CLI::App& app);
+void addViewCommand(CLI::App& app);
 
 }  // namespace fibscope

@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   fibscope::addGpuInfoCommand(app);
   fibscope::addRenderCommand(app);
   fibscope::addBenchCommand(app);
+  fibscope::addViewCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

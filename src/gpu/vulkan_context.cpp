@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cctype>
+#include <string_view>
+#include <vector>
 
 #include "gpu/vk_check.h"
 
@@ -39,6 +41,31 @@ std::string deviceList(std::span<const DeviceInfo> devices, bool with_missing) {
   return list.empty() ? "none" : list;
 }
 
+// The devices with "cannot present to the window" added to what they lack
+// when their queue family cannot present to `surface` (or they have no
+// VK_KHR_swapchain).
+std::vector<DeviceInfo> presentableDevices(std::span<const DeviceInfo> devices, VkSurfaceKHR surface) {
+  std::vector<DeviceInfo> result(devices.begin(), devices.end());
+  for (DeviceInfo& d : result) {
+    VkBool32 supported = VK_FALSE;
+    if (d.queue_family >= 0 &&
+        vkGetPhysicalDeviceSurfaceSupportKHR(d.handle, uint32_t(d.queue_family), surface, &supported) != VK_SUCCESS)
+      supported = VK_FALSE;
+    uint32_t count = 0;
+    vkEnumerateDeviceExtensionProperties(d.handle, nullptr, &count, nullptr);
+    std::vector<VkExtensionProperties> extensions(count);
+    vkEnumerateDeviceExtensionProperties(d.handle, nullptr, &count, extensions.data());
+    bool swapchain = false;
+    for (const auto& e : extensions)
+      swapchain = swapchain || std::string_view(e.extensionName) == VK_KHR_SWAPCHAIN_EXTENSION_NAME;
+    if (!supported || !swapchain) {
+      if (!d.missing.empty()) d.missing += ", ";
+      d.missing += "cannot present to the window";
+    }
+  }
+  return result;
+}
+
 }  // namespace
 
 const DeviceInfo& chooseDevice(std::span<const DeviceInfo> devices, const std::string& name) {
@@ -58,8 +85,19 @@ const DeviceInfo& chooseDevice(std::span<const DeviceInfo> devices, const std::s
   return *best;
 }
 
-VulkanContext::VulkanContext(const ContextOptions& options)
-    : instance_(options.instance), info_(chooseDevice(instance_.devices(), options.device_name)) {
+VulkanContext::VulkanContext(const ContextOptions& options) : instance_(options.instance) {
+  try {
+    if (options.surface_factory) {
+      surface_ = options.surface_factory(instance_.handle());
+      if (surface_ == VK_NULL_HANDLE) throw Error("vulkan: the window's surface could not be created");
+      info_ = chooseDevice(presentableDevices(instance_.devices(), surface_), options.device_name);
+    } else {
+      info_ = chooseDevice(instance_.devices(), options.device_name);
+    }
+  } catch (...) {
+    release();
+    throw;
+  }
   vkGetPhysicalDeviceMemoryProperties(info_.handle, &memory_);
   VkPhysicalDeviceProperties properties;
   vkGetPhysicalDeviceProperties(info_.handle, &properties);
@@ -97,11 +135,21 @@ VulkanContext::VulkanContext(const ContextOptions& options)
   queue_info.queueCount = 1;
   queue_info.pQueuePriorities = &priority;
 
+  const char* swapchain_extension = VK_KHR_SWAPCHAIN_EXTENSION_NAME;
   VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
   info.pNext = &features;
   info.queueCreateInfoCount = 1;
   info.pQueueCreateInfos = &queue_info;
-  throwIfFailed(vkCreateDevice(info_.handle, &info, nullptr, &device_), "vkCreateDevice on " + info_.name);
+  if (surface_ != VK_NULL_HANDLE) {
+    info.enabledExtensionCount = 1;
+    info.ppEnabledExtensionNames = &swapchain_extension;
+  }
+  const VkResult created = vkCreateDevice(info_.handle, &info, nullptr, &device_);
+  if (created != VK_SUCCESS) {
+    device_ = VK_NULL_HANDLE;
+    release();
+    throwIfFailed(created, "vkCreateDevice on " + info_.name);
+  }
   vkGetDeviceQueue(device_, queueFamily(), 0, &queue_);
 
   VkCommandPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
@@ -124,6 +172,9 @@ void VulkanContext::release() {
   }
   command_pool_ = VK_NULL_HANDLE;
   device_ = VK_NULL_HANDLE;
+  // Before the instance (a member destroyed after this).
+  if (surface_ != VK_NULL_HANDLE) vkDestroySurfaceKHR(instance_.handle(), surface_, nullptr);
+  surface_ = VK_NULL_HANDLE;
 }
 
 }  // namespace fibscope::gpu

@@ -6,6 +6,7 @@
 
 #include <vulkan/vulkan.h>
 
+#include <functional>
 #include <span>
 #include <string>
 
@@ -18,6 +19,13 @@ struct ContextOptions {
   // Non-empty: the first device whose name contains this (case-insensitive),
   // else Error listing the devices. Empty: the best usable device.
   std::string device_name;
+  // Set for a window: makes the surface right after the instance (e.g. with
+  // glfwCreateWindowSurface; VK_NULL_HANDLE or an exception is a failure);
+  // only devices whose queue family can present to it are considered, and
+  // the device gets VK_KHR_swapchain. The context destroys the surface
+  // before the instance. instance.extensions must name the surface
+  // extensions the factory needs.
+  std::function<VkSurfaceKHR(VkInstance)> surface_factory;
 };
 
 // The usable device of the best type (discrete GPU > integrated GPU >
@@ -50,11 +58,15 @@ class VulkanContext {
   // multiDrawIndirect and drawIndirectFirstInstance where the device has
   // them (the lines baseline falls back without them).
   const VkPhysicalDeviceFeatures& enabledFeatures() const { return enabled_; }
+  // The window's surface (VK_NULL_HANDLE without a surface factory); the
+  // device can present to it from queue().
+  VkSurfaceKHR surface() const { return surface_; }
 
  private:
   void release();
 
   VulkanInstance instance_;
+  VkSurfaceKHR surface_ = VK_NULL_HANDLE;
   DeviceInfo info_;
   VkPhysicalDeviceMemoryProperties memory_{};
   VkPhysicalDeviceLimits limits_{};

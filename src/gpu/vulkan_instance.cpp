@@ -222,6 +222,13 @@ VulkanInstance::VulkanInstance(const InstanceOptions& options)
   // Portability drivers (MoltenVK) are listed only when asked for.
   const bool portability = hasInstanceExtension(nullptr, VK_KHR_PORTABILITY_ENUMERATION_EXTENSION_NAME);
   if (portability) extensions.push_back(VK_KHR_PORTABILITY_ENUMERATION_EXTENSION_NAME);
+  for (const std::string& name : options.extensions) {
+    if (!hasInstanceExtension(nullptr, name.c_str()))
+      throw Error("vulkan: the instance extension " + name + " is not available (a window needs it)");
+    bool listed = false;
+    for (const char* e : extensions) listed = listed || name == e;
+    if (!listed) extensions.push_back(name.c_str());
+  }
 
   VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
   app.pApplicationName = "fibscope";

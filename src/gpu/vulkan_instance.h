@@ -52,6 +52,10 @@ struct InstanceOptions {
   // with validation on (without it, only the loader reports, and a failure
   // it explains becomes the one-line Error).
   std::shared_ptr<DebugLog> log;
+  // More instance extensions to enable, e.g. the surface extensions a window
+  // system needs (glfwGetRequiredInstanceExtensions). Error naming the first
+  // one the loader does not offer.
+  std::vector<std::string> extensions;
 };
 
 struct DeviceInfo {

@@ -1,0 +1,67 @@
+// `fibscope view [FILE...] [--size WxH] [--screenshot OUT.png --frames N]
+// [--script FILE] [--offscreen] [--no-vsync] [--validate] [--device NAME]
+// [--phantom-streamlines N] [render settings]`: the interactive viewer
+// (src/app/viewer/). Without a display it renders offscreen, so scripts and
+// tests run anywhere Vulkan does.
+#include <CLI/CLI.hpp>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "app/commands.h"
+#include "app/render_options.h"
+#include "app/viewer/viewer_app.h"
+#include "core/error.h"
+
+namespace fibscope {
+namespace {
+
+struct ViewCommandOptions {
+  RenderCliOptions render;
+  std::vector<std::string> files;
+  std::string screenshot;
+  uint32_t frames = 0;
+  std::string script;
+  bool offscreen = false;
+  bool no_vsync = false;
+};
+
+void runView(ViewCommandOptions o) {
+  ViewerOptions v;
+  v.files = o.files;
+  v.phantom_streamlines = o.render.phantom_streamlines;
+  parseFrameSize(o.render.size, v.width, v.height);
+  v.settings = renderSettingsFrom(o.render);
+  if (!o.screenshot.empty() && (o.screenshot.size() < 5 || o.screenshot.substr(o.screenshot.size() - 4) != ".png"))
+    throw Error("--screenshot: the output must be a .png file, got '" + o.screenshot + "'");
+  v.screenshot = o.screenshot;
+  v.frames = o.frames;
+  // A screenshot run stops by itself: one frame unless told otherwise.
+  if (!v.screenshot.empty() && v.frames == 0 && o.script.empty()) v.frames = 1;
+  v.script = o.script;
+  v.offscreen = o.offscreen;
+  v.vsync = !o.no_vsync;
+  v.validate = o.render.validate;
+  v.device = o.render.device;
+  runViewer(v);
+}
+
+}  // namespace
+
+void addViewCommand(CLI::App& app) {
+  auto o = std::make_shared<ViewCommandOptions>();
+  o->render.size = "1280x800";
+  CLI::App* cmd = app.add_subcommand("view", "Open the interactive viewer on tractograms (none: the built-in phantom)");
+  addRenderCliOptions(cmd, o->render);
+  // The viewer opens several files: the positional takes them all.
+  cmd->remove_option(cmd->get_option("input"));
+  cmd->add_option("files", o->files, "Tractograms (.tck .trk .trx .vtk .fbl); none: the built-in phantom");
+  cmd->add_option("--screenshot", o->screenshot, "Write the window (panels included) to this PNG after the last frame");
+  cmd->add_option("--frames", o->frames, "Render this many frames, then exit");
+  cmd->add_option("--script", o->script, "Run viewer commands from this file (one a line)");
+  cmd->add_flag("--offscreen", o->offscreen, "No window: render into an offscreen image");
+  cmd->add_flag("--no-vsync", o->no_vsync, "Present without waiting for vertical sync (mailbox or immediate)");
+  cmd->callback([o] { runView(*o); });
+}
+
+}  // namespace fibscope

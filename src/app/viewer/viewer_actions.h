@@ -1,0 +1,61 @@
+// What the viewer can be asked to do, whoever asks: mouse and keys
+// (viewer_input), the panels (viewer_ui) and scripts (viewer_script) all
+// produce these, and ViewerApp::apply is the one place that carries them
+// out. Adding a command: an alternative here, its parse in viewer_script.cpp,
+// its case in ViewerApp::apply.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <variant>
+
+#include "render/camera.h"
+#include "render/render_settings.h"
+
+namespace fibscope {
+
+struct OrbitAction {  // left drag, window pixels (y down)
+  double dx = 0, dy = 0;
+};
+struct PanAction {  // middle or shift-left drag, window pixels (y down)
+  double dx = 0, dy = 0;
+};
+struct DollyAction {  // wheel steps, + = towards the scene
+  double steps = 0;
+};
+struct ViewAction {  // a standard view, or (none) the reset view
+  std::optional<StandardView> view;
+};
+struct FovAction {
+  double degrees = 30;
+};
+struct SetAction {  // a RenderSettings field by its script name (applySetting)
+  std::string key, value;
+};
+struct ScreenshotAction {
+  std::string path;                // .png
+  uint32_t width = 0, height = 0;  // 0: the window as shown, panels included; else the scene alone at this size
+};
+struct OpenAction {  // a tractogram file to add to the model list (empty: the built-in phantom)
+  std::string path;
+};
+struct QuitAction {};
+
+using ViewerAction = std::variant<OrbitAction, PanAction, DollyAction, ViewAction, FovAction, SetAction,
+                                  ScreenshotAction, OpenAction, QuitAction>;
+
+// Sets one RenderSettings field from text, as `set KEY VALUE` in a script:
+//   pipeline compute|lines|raw-compute, culling none|frustum|two-phase,
+//   color orientation|solid|fiber, lighting illuminated|none,
+//   width 1..4 (px), ssao on|off, background R,G,B (each in [0, 1]).
+// Throws Error (one line) naming the key and what was expected; leaves
+// `settings` unchanged then. Safe on untrusted text.
+void applySetting(RenderSettings& settings, std::string_view key, std::string_view value);
+
+// "sagittal" -> Sagittal ...; "reset" -> a ViewAction without a view.
+// Throws Error listing the names.
+ViewAction parseViewName(std::string_view name);
+
+}  // namespace fibscope

@@ -1,0 +1,69 @@
+#include "app/viewer/viewer_input.h"
+
+#include <GLFW/glfw3.h>
+
+namespace fibscope {
+
+std::vector<ViewerAction> InputMapper::map(const InputEvent& e, bool want_mouse, bool want_keyboard) {
+  std::vector<ViewerAction> actions;
+  switch (e.type) {
+    case InputEvent::Type::CursorMoved: {
+      const double dx = e.x - last_x_, dy = e.y - last_y_;
+      if (have_cursor_ && (dx != 0 || dy != 0)) {
+        if (drag_ == Drag::Orbit) actions.push_back(OrbitAction{dx, dy});
+        if (drag_ == Drag::Pan) actions.push_back(PanAction{dx, dy});
+      }
+      last_x_ = e.x;
+      last_y_ = e.y;
+      have_cursor_ = true;
+      break;
+    }
+    case InputEvent::Type::MouseButton:
+      if (!e.pressed) {
+        if (e.button == drag_button_) {
+          drag_ = Drag::None;
+          drag_button_ = -1;
+        }
+      } else if (!want_mouse && drag_ == Drag::None) {
+        if (e.button == InputEvent::kLeft) drag_ = e.shift ? Drag::Pan : Drag::Orbit;
+        if (e.button == InputEvent::kMiddle) drag_ = Drag::Pan;
+        if (drag_ != Drag::None) drag_button_ = e.button;
+      }
+      break;
+    case InputEvent::Type::Scroll:
+      if (!want_mouse && e.y != 0) actions.push_back(DollyAction{e.y});
+      break;
+    case InputEvent::Type::Key:
+      if (!e.pressed || want_keyboard) break;
+      switch (e.key) {
+        case GLFW_KEY_1:
+        case GLFW_KEY_S:
+          actions.push_back(ViewAction{StandardView::Sagittal});
+          break;
+        case GLFW_KEY_2:
+        case GLFW_KEY_C:
+          actions.push_back(ViewAction{StandardView::Coronal});
+          break;
+        case GLFW_KEY_3:
+        case GLFW_KEY_A:
+          actions.push_back(ViewAction{StandardView::Axial});
+          break;
+        case GLFW_KEY_R:
+          actions.push_back(ViewAction{});
+          break;
+        case GLFW_KEY_F12:
+        case GLFW_KEY_P:
+          actions.push_back(ScreenshotAction{});  // empty path: the viewer picks a fresh name
+          break;
+        default:
+          break;
+      }
+      break;
+    case InputEvent::Type::Drop:
+      for (const std::string& path : e.paths) actions.push_back(OpenAction{path});
+      break;
+  }
+  return actions;
+}
+
+}  // namespace fibscope

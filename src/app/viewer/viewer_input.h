@@ -1,0 +1,43 @@
+// Mouse and keys to viewer actions, as mrview users expect: left drag
+// orbits, middle drag or shift + left drag pans, the wheel dollies; keys
+// 1/2/3 (or S/C/A) the sagittal, coronal and axial views, R resets,
+// F12 (or P) takes a screenshot; dropped files are opened. ImGui gets the
+// mouse and keyboard first when it wants them (a drag that starts on a
+// panel stays with the panel).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "app/viewer/viewer_actions.h"
+
+namespace fibscope {
+
+// What the window reports (viewer_window turns GLFW callbacks into these).
+struct InputEvent {
+  enum class Type : uint8_t { CursorMoved, MouseButton, Scroll, Key, Drop };
+  enum Button : int { kLeft = 0, kRight = 1, kMiddle = 2 };
+  Type type = Type::CursorMoved;
+  double x = 0, y = 0;  // CursorMoved: window pixels; Scroll: wheel offsets
+  int button = 0;       // MouseButton
+  int key = 0;          // Key: a GLFW_KEY_* code
+  bool pressed = false;  // MouseButton, Key (repeat counts as pressed)
+  bool shift = false, control = false;
+  std::vector<std::string> paths;  // Drop
+};
+
+class InputMapper {
+ public:
+  // The actions `event` asks for. want_mouse / want_keyboard: ImGui's
+  // io.WantCaptureMouse / io.WantCaptureKeyboard for this frame.
+  std::vector<ViewerAction> map(const InputEvent& event, bool want_mouse, bool want_keyboard);
+
+ private:
+  enum class Drag : uint8_t { None, Orbit, Pan };
+  Drag drag_ = Drag::None;
+  int drag_button_ = -1;
+  bool have_cursor_ = false;
+  double last_x_ = 0, last_y_ = 0;
+};
+
+}  // namespace fibscope

@@ -1,0 +1,141 @@
+#include "app/viewer/viewer_script.h"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "app/render_options.h"
+#include "core/error.h"
+
+namespace fibscope {
+namespace {
+
+std::vector<std::string_view> splitWords(std::string_view line) {
+  std::vector<std::string_view> words;
+  size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r')) ++i;
+    size_t j = i;
+    while (j < line.size() && line[j] != ' ' && line[j] != '\t' && line[j] != '\r') ++j;
+    if (j > i) words.push_back(line.substr(i, j - i));
+    i = j;
+  }
+  return words;
+}
+
+double number(std::string_view word, const char* what) {
+  const std::string s(word);
+  double value = 0;
+  char rest = 0;
+  if (std::sscanf(s.c_str(), "%lf%c", &value, &rest) != 1 || !std::isfinite(value))
+    throw Error(std::string(what) + ": expected a number, got '" + s + "'");
+  return value;
+}
+
+void expectArguments(const std::vector<std::string_view>& words, size_t min, size_t max, const char* usage) {
+  const size_t n = words.size() - 1;
+  if (n < min || n > max) throw Error(std::string("expected '") + usage + "', got " + std::to_string(n) + " arguments");
+}
+
+std::variant<ViewerAction, WaitFrames> parseCommand(const std::vector<std::string_view>& w) {
+  const std::string_view name = w[0];
+  if (name == "orbit" || name == "pan") {
+    expectArguments(w, 2, 2, name == "orbit" ? "orbit DX DY" : "pan DX DY");
+    const double dx = number(w[1], "DX"), dy = number(w[2], "DY");
+    if (name == "orbit") return ViewerAction{OrbitAction{dx, dy}};
+    return ViewerAction{PanAction{dx, dy}};
+  }
+  if (name == "dolly") {
+    expectArguments(w, 1, 1, "dolly STEPS");
+    return ViewerAction{DollyAction{number(w[1], "STEPS")}};
+  }
+  if (name == "view") {
+    expectArguments(w, 1, 1, "view sagittal|coronal|axial|reset");
+    return ViewerAction{parseViewName(w[1])};
+  }
+  if (name == "fov") {
+    expectArguments(w, 1, 1, "fov DEG");
+    const double deg = number(w[1], "DEG");
+    if (!(deg >= 10 && deg <= 90)) throw Error("fov: expected 10 to 90 degrees, got " + std::string(w[1]));
+    return ViewerAction{FovAction{deg}};
+  }
+  if (name == "set") {
+    expectArguments(w, 2, 2, "set KEY VALUE");
+    RenderSettings scratch;  // checks the value now, not when the line runs
+    applySetting(scratch, w[1], w[2]);
+    return ViewerAction{SetAction{std::string(w[1]), std::string(w[2])}};
+  }
+  if (name == "wait") {
+    expectArguments(w, 1, 1, "wait FRAMES");
+    const double n = number(w[1], "FRAMES");
+    if (!(n >= 1 && n <= 100000) || n != std::floor(n))
+      throw Error("wait: expected 1 to 100000 frames, got " + std::string(w[1]));
+    return WaitFrames{uint32_t(n)};
+  }
+  if (name == "screenshot") {
+    expectArguments(w, 1, 2, "screenshot OUT.png [WxH]");
+    ScreenshotAction shot{std::string(w[1])};
+    if (shot.path.size() < 5 || shot.path.substr(shot.path.size() - 4) != ".png")
+      throw Error("screenshot: the output must be a .png file, got '" + shot.path + "'");
+    if (w.size() == 3) parseFrameSize(std::string(w[2]), shot.width, shot.height);
+    return ViewerAction{shot};
+  }
+  if (name == "quit") {
+    expectArguments(w, 0, 0, "quit");
+    return ViewerAction{QuitAction{}};
+  }
+  throw Error("unknown command '" + std::string(name) +
+              "' (expected orbit, pan, dolly, view, fov, set, wait, screenshot or quit)");
+}
+
+}  // namespace
+
+std::vector<ScriptStep> parseScript(std::string_view text, const std::string& path) {
+  std::vector<ScriptStep> steps;
+  int line_number = 0;
+  size_t start = 0;
+  while (start <= text.size()) {
+    size_t end = text.find('\n', start);
+    if (end == std::string_view::npos) end = text.size();
+    std::string_view line = text.substr(start, end - start);
+    ++line_number;
+    start = end + 1;
+    if (const size_t hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
+    const std::vector<std::string_view> words = splitWords(line);
+    if (words.empty()) continue;
+    try {
+      steps.push_back({line_number, parseCommand(words)});
+    } catch (const Error& e) {
+      throw Error(path + ":" + std::to_string(line_number) + ": " + e.what());
+    }
+  }
+  return steps;
+}
+
+std::vector<ScriptStep> loadScript(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) failErrno(path, "cannot open the script");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parseScript(text.str(), path);
+}
+
+std::vector<ViewerAction> ScriptRunner::nextFrame() {
+  std::vector<ViewerAction> actions;
+  if (waiting_ > 0) {
+    --waiting_;
+    return actions;
+  }
+  while (next_ < steps_.size()) {
+    const ScriptStep& step = steps_[next_++];
+    if (const auto* wait = std::get_if<WaitFrames>(&step.command)) {
+      waiting_ = wait->frames - 1;  // this frame is the first one waited
+      break;
+    }
+    actions.push_back(std::get<ViewerAction>(step.command));
+  }
+  return actions;
+}
+
+}  // namespace fibscope

@@ -1,0 +1,58 @@
+// Viewer scripts: a text file, one command per line, '#' starts a comment,
+// run between frames through the same actions as the mouse, keys and panels
+// (viewer_actions.h):
+//   orbit DX DY | pan DX DY     (window pixels, as a drag)
+//   dolly STEPS                 (wheel steps, + = closer)
+//   view sagittal|coronal|axial|reset
+//   fov DEG                     (10 to 90)
+//   set KEY VALUE               (applySetting)
+//   wait N                      (frames, 1 to 100000)
+//   screenshot OUT.png [WxH]    (WxH: the scene alone at that size)
+//   quit
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "app/viewer/viewer_actions.h"
+
+namespace fibscope {
+
+struct WaitFrames {
+  uint32_t frames = 1;
+};
+
+struct ScriptStep {
+  int line = 0;  // 1-based, for messages
+  std::variant<ViewerAction, WaitFrames> command;
+};
+
+// Parses a whole script. `path` only names the script in messages. Throws
+// Error "PATH:LINE: ..." (one line) at the first malformed line. Pure: no
+// files, no GPU; safe on untrusted text.
+std::vector<ScriptStep> parseScript(std::string_view text, const std::string& path);
+// Reads and parses the file (Error naming it when it cannot be read).
+std::vector<ScriptStep> loadScript(const std::string& path);
+
+// Steps through a parsed script, one frame at a time.
+class ScriptRunner {
+ public:
+  ScriptRunner() = default;
+  explicit ScriptRunner(std::vector<ScriptStep> steps) : steps_(std::move(steps)) {}
+
+  // The actions to apply before the next frame: every command up to the
+  // next `wait` (which then holds for its frames), or none while waiting.
+  std::vector<ViewerAction> nextFrame();
+  bool finished() const { return next_ >= steps_.size() && waiting_ == 0; }
+  bool empty() const { return steps_.empty(); }
+
+ private:
+  std::vector<ScriptStep> steps_;
+  size_t next_ = 0;
+  uint32_t waiting_ = 0;
+};
+
+}  // namespace fibscope

@@ -1,0 +1,199 @@
+#include "app/viewer/viewer_ui.h"
+
+#include <imgui.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <string>
+
+namespace fibscope {
+namespace {
+
+// A combo over an enum whose values are 0..count-1 with names from `name`.
+template <typename Enum, typename NameFn>
+bool enumCombo(const char* label, Enum& value, int count, NameFn name) {
+  bool changed = false;
+  const std::string current(name(value));
+  if (ImGui::BeginCombo(label, current.c_str())) {
+    for (int i = 0; i < count; ++i) {
+      const Enum option = Enum(i);
+      const std::string text(name(option));
+      if (ImGui::Selectable(text.c_str(), option == value)) {
+        changed = option != value;
+        value = option;
+      }
+    }
+    ImGui::EndCombo();
+  }
+  return changed;
+}
+
+void modelsPanel(ViewerState& state, std::vector<ViewerAction>& actions) {
+  ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(300, 0), ImGuiCond_FirstUseEver);
+  if (!ImGui::Begin("Models", &state.show_models)) {
+    ImGui::End();
+    return;
+  }
+  for (int i = 0; i < int(state.models.size()); ++i) {
+    ModelInfo& m = state.models[size_t(i)];
+    ImGui::PushID(i);
+    ImGui::Checkbox("##visible", &m.visible);
+    ImGui::SameLine();
+    if (ImGui::Selectable(m.name.c_str(), state.active_model == i)) state.active_model = i;
+    if (state.active_model == i) {
+      ImGui::TextDisabled("%llu streamlines, %llu segments, %llu fiblets",
+                          static_cast<unsigned long long>(m.streamlines),
+                          static_cast<unsigned long long>(m.segments), static_cast<unsigned long long>(m.fiblets));
+      ImGui::TextDisabled("loaded in %.2f s", m.load_seconds);
+    }
+    ImGui::PopID();
+  }
+  if (state.models.empty()) ImGui::TextDisabled("no model");
+  ImGui::Separator();
+  static char path[1024] = "";
+  ImGui::SetNextItemWidth(-60);
+  const bool enter = ImGui::InputTextWithHint("##path", "file.tck / .trk / .trx / .fbl", path, sizeof(path),
+                                              ImGuiInputTextFlags_EnterReturnsTrue);
+  ImGui::SameLine();
+  if ((ImGui::Button("Open") || enter) && path[0] != 0) actions.push_back(OpenAction{path});
+  ImGui::End();
+}
+
+void settingsPanel(ViewerState& state, std::vector<ViewerAction>& actions) {
+  ImGui::SetNextWindowPos(ImVec2(10, 200), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(300, 0), ImGuiCond_FirstUseEver);
+  if (!ImGui::Begin("Render settings", &state.show_settings)) {
+    ImGui::End();
+    return;
+  }
+  RenderSettings& s = state.settings;
+  enumCombo("pipeline", s.pipeline, 3, renderPipelineName);
+  if (s.pipeline == RenderPipeline::Compute) enumCombo("culling", s.culling, 3, cullingModeName);
+  ImGui::SliderFloat("line width", &s.line_width_px, 1.0f, 4.0f, "%.1f px");
+  enumCombo("colour", s.color, 3, colorModeName);
+  if (s.color == ColorMode::Solid) ImGui::ColorEdit3("solid colour", s.solid_color.data());
+  enumCombo("lighting", s.lighting, 2, lightingName);
+  ImGui::Checkbox("SSAO", &s.ssao);
+  if (s.ssao) {
+    ImGui::SliderFloat("AO radius", &s.ssao_radius_px, 1.0f, 40.0f, "%.0f px");
+    ImGui::SliderFloat("AO strength", &s.ssao_strength, 0.0f, 1.0f, "%.2f");
+  }
+  ImGui::ColorEdit3("background", s.background.data());
+  float fov = float(state.fov_deg);
+  if (ImGui::SliderFloat("field of view", &fov, 10.0f, 90.0f, "%.0f deg")) actions.push_back(FovAction{fov});
+
+  ImGui::Separator();
+  ImGui::TextUnformatted("View");
+  if (ImGui::Button("Sagittal")) actions.push_back(ViewAction{StandardView::Sagittal});
+  ImGui::SameLine();
+  if (ImGui::Button("Coronal")) actions.push_back(ViewAction{StandardView::Coronal});
+  ImGui::SameLine();
+  if (ImGui::Button("Axial")) actions.push_back(ViewAction{StandardView::Axial});
+  ImGui::SameLine();
+  if (ImGui::Button("Reset")) actions.push_back(ViewAction{});
+
+  ImGui::Separator();
+  static char shot[1024] = "";
+  if (shot[0] == 0) std::snprintf(shot, sizeof(shot), "%s", state.screenshot_path.c_str());
+  ImGui::SetNextItemWidth(-1);
+  if (ImGui::InputText("##shot", shot, sizeof(shot))) state.screenshot_path = shot;
+  int size[2] = {state.screenshot_width, state.screenshot_height};
+  if (ImGui::InputInt2("size (0: window)", size)) {
+    state.screenshot_width = std::clamp(size[0], 0, 16384);
+    state.screenshot_height = std::clamp(size[1], 0, 16384);
+  }
+  if (ImGui::Button("Screenshot")) {
+    const bool sized = state.screenshot_width > 0 && state.screenshot_height > 0;
+    actions.push_back(ScreenshotAction{state.screenshot_path, sized ? uint32_t(state.screenshot_width) : 0u,
+                                       sized ? uint32_t(state.screenshot_height) : 0u});
+  }
+  ImGui::End();
+}
+
+void performanceOverlay(ViewerState& state) {
+  const ImGuiViewport* viewport = ImGui::GetMainViewport();
+  ImGui::SetNextWindowPos(ImVec2(viewport->WorkPos.x + viewport->WorkSize.x - 10, viewport->WorkPos.y + 10),
+                          ImGuiCond_Always, ImVec2(1, 0));
+  ImGui::SetNextWindowBgAlpha(0.6f);
+  const ImGuiWindowFlags flags = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
+                                 ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoFocusOnAppearing |
+                                 ImGuiWindowFlags_NoNav | ImGuiWindowFlags_NoMove;
+  if (!ImGui::Begin("Performance", &state.show_performance, flags)) {
+    ImGui::End();
+    return;
+  }
+  if (state.frames.empty()) {
+    ImGui::TextUnformatted("no frame yet");
+    ImGui::End();
+    return;
+  }
+  // Averages over the last second or so smooth the numbers enough to read.
+  const size_t n = std::min<size_t>(state.frames.size(), 30);
+  double frame_ms = 0, gpu_ms = 0;
+  for (size_t i = state.frames.size() - n; i < state.frames.size(); ++i) {
+    frame_ms += state.frames[i].frame_ms;
+    gpu_ms += state.frames[i].gpu.gpu_ms;
+  }
+  frame_ms /= double(n);
+  gpu_ms /= double(n);
+  ImGui::Text("frame %.1f ms (%.0f fps)", frame_ms, frame_ms > 0 ? 1000.0 / frame_ms : 0.0);
+  ImGui::Text("GPU   %.1f ms", gpu_ms);
+  float history[ViewerState::kFrameHistory];
+  for (size_t i = 0; i < state.frames.size(); ++i) history[i] = float(state.frames[i].frame_ms);
+  ImGui::PlotLines("##frames", history, int(state.frames.size()), 0, nullptr, 0.0f, FLT_MAX, ImVec2(220, 40));
+  const FrameStats& last = state.frames.back().gpu;
+  if (ImGui::BeginTable("passes", 2, ImGuiTableFlags_SizingFixedFit)) {
+    for (const PassTiming& p : last.passes) {
+      ImGui::TableNextRow();
+      ImGui::TableNextColumn();
+      ImGui::TextUnformatted(p.name.c_str());
+      ImGui::TableNextColumn();
+      ImGui::Text("%6.2f ms", p.ms);
+    }
+    ImGui::EndTable();
+  }
+  if (last.fiblets_total > 0)
+    ImGui::Text("fiblets %llu + %llu LoD of %llu", static_cast<unsigned long long>(last.fiblets_drawn),
+                static_cast<unsigned long long>(last.fiblets_lod),
+                static_cast<unsigned long long>(last.fiblets_total));
+  else
+    ImGui::Text("segments %llu", static_cast<unsigned long long>(last.segments_total));
+  ImGui::End();
+}
+
+void statusLine(const ViewerState& state) {
+  if (state.status.empty()) return;
+  const ImGuiViewport* viewport = ImGui::GetMainViewport();
+  ImGui::SetNextWindowPos(ImVec2(viewport->WorkPos.x + 10, viewport->WorkPos.y + viewport->WorkSize.y - 10),
+                          ImGuiCond_Always, ImVec2(0, 1));
+  ImGui::SetNextWindowBgAlpha(0.6f);
+  ImGui::Begin("##status", nullptr,
+               ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoNav |
+                   ImGuiWindowFlags_NoFocusOnAppearing | ImGuiWindowFlags_NoMove);
+  ImGui::TextUnformatted(state.status.c_str());
+  ImGui::End();
+}
+
+}  // namespace
+
+std::vector<ViewerAction> drawViewerUi(ViewerState& state) {
+  std::vector<ViewerAction> actions;
+  if (ImGui::BeginMainMenuBar()) {
+    if (ImGui::BeginMenu("Window")) {
+      ImGui::MenuItem("Models", nullptr, &state.show_models);
+      ImGui::MenuItem("Render settings", nullptr, &state.show_settings);
+      ImGui::MenuItem("Performance", nullptr, &state.show_performance);
+      ImGui::EndMenu();
+    }
+    if (ImGui::MenuItem("Screenshot")) actions.push_back(ScreenshotAction{});
+    ImGui::EndMainMenuBar();
+  }
+  if (state.show_models) modelsPanel(state, actions);
+  if (state.show_settings) settingsPanel(state, actions);
+  if (state.show_performance) performanceOverlay(state);
+  statusLine(state);
+  return actions;
+}
+
+}  // namespace fibscope

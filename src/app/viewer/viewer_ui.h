@@ -1,0 +1,17 @@
+// The viewer's panels, all in one place (STYLE.md rule 10): they edit
+// ViewerState (settings, model visibility and choice, UI flags), read its
+// statistics, and ask for everything else (camera views, screenshots,
+// opening files) by returning actions for ViewerApp::apply. Call between
+// ImGuiLayer::newFrame and record.
+#pragma once
+
+#include <vector>
+
+#include "app/viewer/viewer_actions.h"
+#include "app/viewer/viewer_state.h"
+
+namespace fibscope {
+
+std::vector<ViewerAction> drawViewerUi(ViewerState& state);
+
+}  // namespace fibscope
