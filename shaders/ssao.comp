@@ -14,6 +14,9 @@
 //   - Neighbours of the same fiber never occlude, so a lone fiber over an
 //     empty background stays exactly 1 however it turns in depth.
 // ao = 1 - strength * (weighted occluders / total weight); 1 where empty.
+// Multi-scale AO (FiberVisualizer): with scales > 1 the same again on discs
+// of 2, 4, 8 times the radius, the factors multiplied: contact shadows from
+// the first scale, whole bundles darkening those behind from the last.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_buffer_reference : require
@@ -41,21 +44,26 @@ void main() {
     const CameraBlock cam = CameraRef(pc.camera).camera;
     const float z = viewDistance(cam, centre.depth);
     const float rotation = float(shadeHash(p.x * 0x9E3779B1u ^ p.y * 0x85EBCA77u) >> 8) * (6.28318531 / 16777216.0);
-    float occluded = 0.0, total = 0.0;
-    for (uint i = 0u; i < kSsaoSamples; ++i) {
-      const float r = pc.radius_px * sqrt((float(i) + 0.5) / float(kSsaoSamples));
-      const float a = float(i) * kGoldenAngle + rotation;
-      const float weight = 1.0 - 0.5 * r / pc.radius_px;
-      total += weight;
-      const ivec2 q = ivec2(floor(vec2(p) + 0.5 + r * vec2(cos(a), sin(a))));
-      if (q.x < 0 || q.y < 0 || q.x >= int(pc.width) || q.y >= int(pc.height)) continue;
-      const GBufferTexel t = gbuffer.texels[uint(q.y) * pc.width + uint(q.x)];
-      if (t.fiber == kNoFiberId || t.fiber == centre.fiber) continue;
-      const float nearer = z - viewDistance(cam, t.depth);
-      if (nearer > pc.epsilon_mm && nearer < pc.range_mm)
-        occluded += weight * (1.0 - smoothstep(0.5 * pc.range_mm, pc.range_mm, nearer));
+    // Scale k samples a disc 2^k times wider; the factors multiply.
+    for (uint k = 0u; k < pc.scales; ++k) {
+      const float radius = pc.radius_px * float(1u << k);
+      const float turn = rotation + float(k) * kGoldenAngle;
+      float occluded = 0.0, total = 0.0;
+      for (uint i = 0u; i < kSsaoSamples; ++i) {
+        const float r = radius * sqrt((float(i) + 0.5) / float(kSsaoSamples));
+        const float a = float(i) * kGoldenAngle + turn;
+        const float weight = 1.0 - 0.5 * r / radius;
+        total += weight;
+        const ivec2 q = ivec2(floor(vec2(p) + 0.5 + r * vec2(cos(a), sin(a))));
+        if (q.x < 0 || q.y < 0 || q.x >= int(pc.width) || q.y >= int(pc.height)) continue;
+        const GBufferTexel t = gbuffer.texels[uint(q.y) * pc.width + uint(q.x)];
+        if (t.fiber == kNoFiberId || t.fiber == centre.fiber) continue;
+        const float nearer = z - viewDistance(cam, t.depth);
+        if (nearer > pc.epsilon_mm && nearer < pc.range_mm)
+          occluded += weight * (1.0 - smoothstep(0.5 * pc.range_mm, pc.range_mm, nearer));
+      }
+      ao *= 1.0 - pc.strength * occluded / total;
     }
-    ao = 1.0 - pc.strength * occluded / total;
   }
   AoRef(pc.ao).values[index] = ao;
 }

@@ -7,6 +7,7 @@
 //   ssao.comp       G-buffer depth -> raw ambient-occlusion factor per pixel
 //   ssao_blur.comp  depth-aware separable blur of that factor (run twice: x, y)
 //   shade.comp      colour x lighting x ambient occlusion -> RGBA8
+//   fxaa.comp       optional anti-aliasing of that RGBA8 image
 #ifndef FIBSCOPE_SHADERS_SHARED_SHADE_PUSH_H
 #define FIBSCOPE_SHADERS_SHARED_SHADE_PUSH_H
 
@@ -24,6 +25,13 @@ SHADER_NAMESPACE_BEGIN
 SHADE_CONST uint kShadeColorSolid = 0u;
 SHADE_CONST uint kShadeColorOrientation = 1u;
 SHADE_CONST uint kShadeColorPerFiber = 2u;
+SHADE_CONST uint kShadeColorScalar = 3u;
+SHADE_CONST uint kShadeColorNormal = 4u;
+// Entries of one colormap table (src/render/colormap.h).
+SHADE_CONST uint kShadeColormapEntries = 256u;
+// ColorMode::Normal: below this |V - (V.T) T| the line is seen end-on and
+// N = V (the tangent's 16-bit octahedral encoding is good to ~1e-4).
+SHADE_CONST float kShadeNormalParallelEps = 1e-3f;
 // ShadePush::lighting (RenderSettings::lighting).
 SHADE_CONST uint kShadeLightingNone = 0u;
 SHADE_CONST uint kShadeLightingIlluminated = 1u;
@@ -32,6 +40,8 @@ SHADE_CONST uint kShadeLightingIlluminated = 1u;
 // pixel), and the blur's half width in pixels.
 SHADE_CONST uint kSsaoSamples = 16u;
 SHADE_CONST uint kSsaoBlurRadius = 4u;
+// RenderSettings::ao_scales at most: radii r, 2r, 4r, 8r.
+SHADE_CONST uint kSsaoMaxScales = 4u;
 
 // The headlight: the direction towards the light in VIEW space (x right,
 // y up, +z towards the viewer), a little above and to the left of the eye so
@@ -45,6 +55,9 @@ SHADE_CONST float kShadeLightViewZ = 1.0f;
 // within radius_px that lie nearer the camera than the pixel by more than
 // epsilon_mm and less than range_mm (a smooth falloff ends at range_mm),
 // weighted by closeness; ao = 1 - strength * fraction. Empty pixels get 1.
+// Multi-scale (scales > 1): the same at radius_px * 2^k for k = 0 ..
+// scales - 1 (each scale's spiral turned by a further golden angle), and
+// ao = the product of the per-scale factors, so more scales never lighten.
 struct SsaoPush {
   uint64_t camera;   // CameraBlock: depth_range linearises the clip depth
   uint64_t gbuffer;  // GBufferTexel per pixel
@@ -55,6 +68,8 @@ struct SsaoPush {
   float epsilon_mm;
   float range_mm;
   float strength;
+  uint scales;  // 1 .. kSsaoMaxScales
+  uint pad0;
 };
 
 // ssao_blur.comp: ao_out = the average of ao_in over the 2 * kSsaoBlurRadius
@@ -82,32 +97,79 @@ struct SsaoBlurPush {
 //   diffuse  = sqrt(1 - (L.T)^2)
 //   specular = max(0, sqrt(1 - (L.T)^2) sqrt(1 - (V.T)^2) - (L.T)(V.T))^shininess
 //   colour   = base * (ambient + diffuse_k * diffuse) + specular_k * specular
+// Base colours: Scalar reads fiber_scalars[fiber] and the colormap table
+// (entry round(255 t), t = (s - scalar_min) / (scalar_max - scalar_min)
+// clamped, NaN -> 0, max == min -> 0.5); without scalars (or a fiber id >=
+// fiber_count) it falls back to Orientation. Normal: 0.5 + 0.5 N in view
+// space, N = normalize(V - (V.T) T), or V when that is shorter than
+// kShadeNormalParallelEps. Selection (selection_bits != 0): selected fibers
+// take the highlight colour as base; unselected ones end as
+// mix(colour, background, dim_unselected) after lighting and occlusion.
 struct ShadePush {
   uint64_t camera;
   uint64_t gbuffer;
-  uint64_t ao;     // float per pixel, or 0: no ambient occlusion
-  uint64_t color;  // uint per pixel (written)
+  uint64_t ao;              // float per pixel, or 0: no ambient occlusion
+  uint64_t color;           // uint per pixel (written)
+  uint64_t colormap;        // kShadeColormapEntries RGBA8 uints: the chosen colormap's table
+  uint64_t fiber_scalars;   // float per fiber, or 0
+  uint64_t selection_bits;  // uint words, bit f % 32 of word f / 32; or 0: no selection
   uint width;
   uint height;
   uint color_mode;
   uint lighting;
   float solid_r, solid_g, solid_b;
-  float background_r, background_g, background_b;
+  uint background;  // RGBA8 (what the image stores anyway)
   float ambient;
   float diffuse;
   float specular;
   float shininess;
+  float scalar_min;
+  float scalar_max;
+  uint highlight;  // RGBA8
+  float dim_unselected;
+  uint fiber_count;  // fibers the scalars and selection bits cover
+  uint pad0;
+};
+
+// fxaa.comp: FXAA in the manner of Lottes' FXAA 3.11 "quality" preset, on
+// RGBA8 in -> RGBA8 out (A = 255). Per pixel, with luma = 0.299 R + 0.587 G
+// + 0.114 B of the stored (sRGB) values:
+//   1. the local contrast of the pixel and its 4 neighbours; below
+//      max(edge_threshold_min, edge_threshold * max luma) the pixel is copied;
+//   2. the edge is horizontal or vertical by which second differences of
+//      the 3x3 neighbourhood are larger; its far side is the neighbour across
+//      it with the steeper gradient;
+//   3. the edge is followed both ways (kFxaaSearchSteps steps of growing
+//      length) on the luma averaged across it until it departs from the
+//      local average by a quarter of the gradient: the ends;
+//   4. a pixel nearer the end where the edge turns its way blends towards
+//      the far side by 0.5 - (distance to the nearer end) / (edge length);
+//   5. sub-pixel aliasing (a lone bright pixel) blends by subpix * s^2, s
+//      a smoothstep of |3x3 weighted average luma - luma| / contrast;
+// and the output is mix(pixel, far-side neighbour, the larger blend).
+SHADE_CONST uint kFxaaSearchSteps = 12u;
+struct FxaaPush {
+  uint64_t color_in;   // uint per pixel
+  uint64_t color_out;  // uint per pixel (written)
+  uint width;
+  uint height;
+  float edge_threshold;
+  float edge_threshold_min;
+  float subpix;
+  uint pad0;
 };
 
 SHADER_NAMESPACE_END
 
 #ifdef __cplusplus
 #include <cstddef>
-static_assert(sizeof(fibscope::shader::SsaoPush) == 48, "");
+static_assert(sizeof(fibscope::shader::SsaoPush) == 56, "");
 static_assert(sizeof(fibscope::shader::SsaoBlurPush) == 56, "");
-static_assert(sizeof(fibscope::shader::ShadePush) == 88, "");
-static_assert(offsetof(fibscope::shader::ShadePush, width) == 32, "scalars follow the four addresses");
-static_assert(offsetof(fibscope::shader::ShadePush, shininess) == 84, "");
+// 128 bytes: the smallest maxPushConstantsSize Vulkan guarantees.
+static_assert(sizeof(fibscope::shader::ShadePush) == 128, "");
+static_assert(offsetof(fibscope::shader::ShadePush, width) == 56, "scalars follow the seven addresses");
+static_assert(offsetof(fibscope::shader::ShadePush, fiber_count) == 120, "");
+static_assert(sizeof(fibscope::shader::FxaaPush) == 40, "");
 #endif
 
 #endif  // FIBSCOPE_SHADERS_SHARED_SHADE_PUSH_H

@@ -148,7 +148,11 @@ void FrameRenderer::record(VkCommandBuffer cmd, const Camera& camera, const Rend
     gpu::computeToComputeBarrier(cmd);
   }
 
-  recordShade(cmd, shade_pass_, targets_, settings, &timer_);
+  // Per-fiber attributes cover the fibers of the tractogram drawn.
+  ShadeFiberInputs fibers{scene.fiber_scalars, scene.selection_bits, 0};
+  fibers.fiber_count = settings.pipeline == RenderPipeline::Compute ? scene.fiblets->block().fiber_count
+                                                                    : scene.raw->streamlineCount();
+  recordShade(cmd, shade_pass_, targets_, settings, &timer_, fibers);
 }
 
 FrameStats FrameRenderer::collect() {

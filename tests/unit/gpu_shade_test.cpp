@@ -10,6 +10,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <set>
 #include <vector>
 
@@ -19,6 +20,8 @@
 #include "io/reader.h"
 #include "phantom/phantom.h"
 #include "render/camera.h"
+#include "render/colormap.h"
+#include "render/gpu_fiber_attributes.h"
 #include "render/gpu_frame_renderer.h"
 #include "render/gpu_shade_pass.h"
 #include "render/gpu_tractogram_upload.h"
@@ -130,7 +133,42 @@ struct Texel {
 };
 
 // The colour the shading promises for one texel, computed on the CPU.
-Rgb expectedColor(const Camera& camera, const RenderSettings& s, const Texel& t) {
+// The unit vector from the texel's surface point to the eye: the world
+// position of the pixel centre at its depth, through the inverse
+// view-projection.
+V3 towardsEye(const Camera& camera, const Texel& t) {
+  const auto inv = inverse(viewProjectionD(camera));
+  const double ndc[4] = {(t.x + 0.5) / camera.width * 2 - 1, (t.y + 0.5) / camera.height * 2 - 1,
+                         double(clipDepth(camera, t.distance_mm)), 1};
+  double w[4] = {0, 0, 0, 0};
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) w[r] += inv[4 * c + r] * ndc[c];
+  const V3 world = {w[0] / w[3], w[1] / w[3], w[2] / w[3]};
+  return normalized(sub(camera.eye, world));
+}
+
+// The camera's look-at frame: right, up, back (towards the eye).
+std::array<V3, 3> viewAxes(const Camera& camera) {
+  const V3 back = normalized(sub(camera.eye, camera.target));
+  const V3 right = normalized(cross(camera.up, back));
+  return {right, cross(back, right), back};
+}
+
+// ColorMode::Normal's promise: N = normalize(V - (V.T) T), or V for a line
+// seen end-on, in view space, as 0.5 + 0.5 N.
+Rgb expectedNormalColor(const Camera& camera, const Texel& t) {
+  const V3 tangent = normalized(t.tangent), v = towardsEye(camera, t);
+  const double vt = dot(v, tangent);
+  V3 n = {v[0] - vt * tangent[0], v[1] - vt * tangent[1], v[2] - vt * tangent[2]};
+  n = std::sqrt(dot(n, n)) > 1e-3 ? normalized(n) : v;
+  const auto axes = viewAxes(camera);
+  return {0.5 + 0.5 * dot(n, axes[0]), 0.5 + 0.5 * dot(n, axes[1]), 0.5 + 0.5 * dot(n, axes[2])};
+}
+
+// The colour the shading promises for one texel, computed on the CPU;
+// `base`, when given, replaces the colour mode's (scalar and highlight
+// colours come from tables the tests check separately).
+Rgb expectedColor(const Camera& camera, const RenderSettings& s, const Texel& t, const Rgb* base_override = nullptr) {
   const V3 tangent = normalized(t.tangent);
   Rgb base{};
   switch (s.color) {
@@ -139,19 +177,14 @@ Rgb expectedColor(const Camera& camera, const RenderSettings& s, const Texel& t)
       base = {std::fabs(tangent[0]), std::fabs(tangent[1]), std::fabs(tangent[2])};
       break;
     case ColorMode::PerFiber: base = expectedFiberColor(t.fiber); break;
-    default: ADD_FAILURE() << "no reference for " << colorModeName(s.color); break;
+    case ColorMode::Normal: base = expectedNormalColor(camera, t); break;
+    case ColorMode::Scalar:
+      if (!base_override) ADD_FAILURE() << "scalar colours need the table entry";
+      break;
   }
+  if (base_override) base = *base_override;
   if (s.lighting == Lighting::None) return base;
-  // World position of the pixel centre at its depth, through the inverse
-  // view-projection; V points from it to the eye.
-  const auto inv = inverse(viewProjectionD(camera));
-  const double ndc[4] = {(t.x + 0.5) / camera.width * 2 - 1, (t.y + 0.5) / camera.height * 2 - 1,
-                         double(clipDepth(camera, t.distance_mm)), 1};
-  double w[4] = {0, 0, 0, 0};
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c) w[r] += inv[4 * c + r] * ndc[c];
-  const V3 world = {w[0] / w[3], w[1] / w[3], w[2] / w[3]};
-  const V3 v = normalized(sub(camera.eye, world));
+  const V3 v = towardsEye(camera, t);
   // The light: view-space (kShadeLightView*) in the camera's look-at frame.
   const V3 back = normalized(sub(camera.eye, camera.target));
   const V3 right = normalized(cross(camera.up, back));
@@ -183,7 +216,8 @@ class GpuShade : public test::GpuTest {
   }
 
   // Shades a G-buffer that is empty but for `texels` and returns RGBA8.
-  std::vector<uint8_t> shade(const std::vector<Texel>& texels, const RenderSettings& settings) {
+  std::vector<uint8_t> shade(const std::vector<Texel>& texels, const RenderSettings& settings,
+                             const ShadeFiberInputs& fibers = {}) {
     std::vector<shader::GBufferTexel> gbuffer(kSize * kSize, {1.0f, shader::kNoFiberId, 0, 0});
     for (const Texel& t : texels)
       gbuffer[t.y * kSize + t.x] = {clipDepth(camera(), t.distance_mm), t.fiber, 0, packTangent(t.tangent)};
@@ -195,7 +229,7 @@ class GpuShade : public test::GpuTest {
       const shader::CameraBlock block = makeCameraBlock(camera(), 1.0f);
       gpu::uploadToBuffer(context(), frame.camera, &block, sizeof(block));
       gpu::uploadToBuffer(context(), frame.gbuffer, gbuffer.data(), gbuffer.size() * sizeof(gbuffer[0]));
-      gpu::submitOnce(context(), [&](VkCommandBuffer cmd) { recordShade(cmd, pass, frame, settings, nullptr); });
+      gpu::submitOnce(context(), [&](VkCommandBuffer cmd) { recordShade(cmd, pass, frame, settings, nullptr, fibers); });
       rgba = downloadColor(context(), frame);
     } catch (...) {
       destroyShadePass(context(), pass);
@@ -503,6 +537,240 @@ TEST_F(GpuShade, wholePhantomFramesInEveryModeAreShaded) {
   const std::vector<uint8_t> rgba = downloadColor(context(), renderer.targets());
   ASSERT_EQ(rgba.size(), 128u * 96u * 4u);
   EXPECT_GT(std::count_if(rgba.begin(), rgba.end(), [](uint8_t v) { return v != 0 && v != 255; }), 1000);
+}
+
+
+// --- Colour modes of the viewer: scalar through a colormap, normal, selection.
+
+Rgb unpackEntry(uint32_t c) { return {(c & 255u) / 255.0, ((c >> 8) & 255u) / 255.0, ((c >> 16) & 255u) / 255.0}; }
+
+TEST_F(GpuShade, scalarColorsAreTheColormapEntryClampedToTheRange) {
+  // Fibers 0..7 with scalars below, at, inside and above [10, 30] mm.
+  const std::vector<float> scalars = {-5.0f, 10.0f, 15.0f, 20.0f, 25.0f, 30.0f, 400.0f, std::nanf("")};
+  GpuFiberAttributes attributes(context(), scalars.size());
+  attributes.uploadScalars(scalars);
+  std::vector<Texel> texels;
+  for (uint32_t f = 0; f < scalars.size(); ++f) texels.push_back({3 + 3 * f, 5 + 2 * f, {1, 0.2, 0.3}, 90.0, f});
+  RenderSettings s;
+  s.color = ColorMode::Scalar;
+  s.lighting = Lighting::None;
+  s.ssao = false;
+  s.scalar_min = 10.0f;
+  s.scalar_max = 30.0f;
+  for (Colormap map : {Colormap::Viridis, Colormap::Magma, Colormap::Grayscale, Colormap::CoolWarm}) {
+    SCOPED_TRACE(std::string(colormapName(map)));
+    s.colormap = map;
+    const std::vector<uint32_t> table = colormapTable(map);
+    const std::vector<uint8_t> rgba =
+        shade(texels, s, ShadeFiberInputs{attributes.scalars(), 0, uint32_t(scalars.size())});
+    // Entry round(255 t), t clamped; NaN takes the low end.
+    const uint32_t entries[] = {0, 0, 64, 128, 191, 255, 255, 0};
+    for (const Texel& t : texels) {
+      const uint32_t want = table[entries[t.fiber]];
+      const auto p = pixel(rgba, t.x, t.y);
+      EXPECT_EQ(uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24, want)
+          << "fiber " << t.fiber << " scalar " << scalars[t.fiber];
+    }
+    // The ends of the range are the colormap's first and last control points.
+    const auto points = colormapControlPoints(map);
+    expectNear(pixel(rgba, texels[1].x, texels[1].y), quantize({points.front()[0], points.front()[1], points.front()[2]}),
+               "low end");
+    expectNear(pixel(rgba, texels[5].x, texels[5].y), quantize({points.back()[0], points.back()[1], points.back()[2]}),
+               "high end");
+  }
+  // Lit: the entry is the base colour of the illuminated-lines formula.
+  s.lighting = Lighting::IlluminatedLines;
+  s.colormap = Colormap::Viridis;
+  const std::vector<uint32_t> table = colormapTable(Colormap::Viridis);
+  const std::vector<uint8_t> lit = shade(texels, s, ShadeFiberInputs{attributes.scalars(), 0, uint32_t(scalars.size())});
+  const Rgb mid = unpackEntry(table[128]);
+  expectNear(pixel(lit, texels[3].x, texels[3].y), quantize(expectedColor(camera(), s, texels[3], &mid)), "lit mid");
+}
+
+TEST_F(GpuShade, scalarModeWithoutScalarsFallsBackToOrientation) {
+  RenderSettings s;
+  s.lighting = Lighting::None;
+  s.ssao = false;
+  const std::vector<Texel> texels = sampleTexels();
+  s.color = ColorMode::Orientation;
+  const std::vector<uint8_t> orientation = shade(texels, s);
+  s.color = ColorMode::Scalar;
+  EXPECT_EQ(shade(texels, s), orientation);
+  // Fiber ids past the scalars' count fall back too (never read past the end).
+  GpuFiberAttributes attributes(context(), 4);
+  attributes.uploadScalars(std::vector<float>{1, 2, 3, 4});
+  EXPECT_EQ(shade(texels, s, ShadeFiberInputs{attributes.scalars(), 0, 4}), orientation);
+}
+
+TEST_F(GpuShade, normalColorsAreTheViewFacingNormalInViewSpace) {
+  RenderSettings s;
+  s.color = ColorMode::Normal;
+  s.lighting = Lighting::None;
+  s.ssao = false;
+  std::vector<Texel> texels = sampleTexels();
+  // A line seen end-on: its tangent is the direction to the eye at its pixel.
+  Texel end_on{16, 16, {0, 0, 1}, 100.0, 9};
+  end_on.tangent = towardsEye(camera(), end_on);
+  texels.push_back(end_on);
+  const std::vector<uint8_t> rgba = shade(texels, s);
+  for (const Texel& t : texels) expectNear(pixel(rgba, t.x, t.y), quantize(expectedNormalColor(camera(), t)), "normal");
+  // End-on, N = V: nearly the view axis, so blue near 1 and red, green near 0.5.
+  const auto p = pixel(rgba, 16, 16);
+  EXPECT_GE(p[2], 250);
+  EXPECT_NEAR(p[0], 128, 20);
+  EXPECT_NEAR(p[1], 128, 20);
+  // Every normal faces the viewer (z >= 0 in view space: blue >= 0.5).
+  for (const Texel& t : texels) EXPECT_GE(pixel(rgba, t.x, t.y)[2], 127) << "texel " << t.x << ", " << t.y;
+  // Lit, the normal colour is the base of the illuminated-lines formula.
+  s.lighting = Lighting::IlluminatedLines;
+  const std::vector<uint8_t> lit = shade(texels, s);
+  for (const Texel& t : texels) expectNear(pixel(lit, t.x, t.y), quantize(expectedColor(camera(), s, t)), "lit normal");
+}
+
+TEST_F(GpuShade, selectedFibersAreHighlightedAndTheOthersDimmed) {
+  RenderSettings s;
+  s.color = ColorMode::Orientation;
+  s.ssao = false;
+  s.background = {0.1f, 0.1f, 0.2f};
+  s.highlight_color = {1.0f, 0.5f, 0.0f};
+  s.dim_unselected = 0.75f;
+  const std::vector<Texel> texels = sampleTexels();  // fibers 100 + 37 i
+  constexpr uint32_t kFibers = 600;
+  std::vector<uint32_t> words(selectionWordCount(kFibers), 0);
+  std::set<uint32_t> selected = {texels[0].fiber, texels[3].fiber, texels[7].fiber};
+  for (uint32_t f : selected) words[f / 32] |= 1u << (f % 32);
+  GpuFiberAttributes attributes(context(), kFibers);
+  EXPECT_EQ(attributes.selection(), 0u) << "nothing uploaded: no selection";
+  attributes.uploadSelection(words);
+  EXPECT_EQ(attributes.selectedCount(), 3u);
+  const Rgb bg = {s.background[0], s.background[1], s.background[2]};
+  const Rgb highlight = {s.highlight_color[0], s.highlight_color[1], s.highlight_color[2]};
+  for (Lighting lighting : {Lighting::None, Lighting::IlluminatedLines}) {
+    SCOPED_TRACE(std::string(lightingName(lighting)));
+    s.lighting = lighting;
+    const std::vector<uint8_t> rgba = shade(texels, s, ShadeFiberInputs{0, attributes.selection(), kFibers});
+    for (const Texel& t : texels) {
+      if (selected.count(t.fiber)) {
+        expectNear(pixel(rgba, t.x, t.y), quantize(expectedColor(camera(), s, t, &highlight)), "selected");
+      } else {
+        const Rgb plain = expectedColor(camera(), s, t);
+        Rgb dimmed{};
+        // Mixed before the final clamp to [0, 1], as the shader does.
+        for (int k = 0; k < 3; ++k) dimmed[k] = plain[k] + s.dim_unselected * (bg[k] - plain[k]);
+        expectNear(pixel(rgba, t.x, t.y), quantize(dimmed), "unselected");
+      }
+    }
+  }
+  // An empty selection (address 0) dims nothing.
+  attributes.uploadSelection(std::vector<uint32_t>(selectionWordCount(kFibers), 0));
+  EXPECT_EQ(attributes.selection(), 0u);
+  EXPECT_EQ(shade(texels, s, ShadeFiberInputs{0, attributes.selection(), kFibers}), shade(texels, s));
+  // Words of the wrong count, or bits past the last fiber, are refused.
+  EXPECT_THROW(attributes.uploadSelection(std::vector<uint32_t>(3, 0)), Error);
+  std::vector<uint32_t> past(selectionWordCount(kFibers), 0);
+  past.back() = 1u << 31;  // fiber 607
+  EXPECT_THROW(attributes.uploadSelection(past), Error);
+  EXPECT_THROW(attributes.uploadScalars(std::vector<float>(kFibers - 1, 0.0f)), Error);
+}
+
+// Fiber 1 at the centre (100 mm), a ring of fiber 2 at 14 to 18 px around
+// it, 2 mm nearer: beyond the first scale's radius, within the third's.
+std::vector<Texel> ringAroundPixel() {
+  std::vector<Texel> texels = {{16, 16, {1, 0, 0}, 100.0, 1}};
+  for (uint32_t y = 0; y < 32; ++y)
+    for (uint32_t x = 0; x < 32; ++x) {
+      const int d2 = (int(x) - 16) * (int(x) - 16) + (int(y) - 16) * (int(y) - 16);
+      if (d2 >= 14 * 14 && d2 <= 18 * 18) texels.push_back({x, y, {0, 1, 0}, 98.0, 2});
+    }
+  return texels;
+}
+
+TEST_F(GpuShade, multiScaleAoReachesFartherAndNeverLightens) {
+  RenderSettings s;
+  s.ssao_radius_px = 5.0f;
+  s.ssao_strength = 0.8f;
+  s.ssao_range_mm = 6.0f;
+  const std::vector<Texel> ring = ringAroundPixel();
+  s.ssao = false;
+  const auto plain = pixel(shade(ring, s), 16, 16);
+  s.ssao = true;
+  s.ao_scales = 1;
+  const auto one = pixel(shade(ring, s), 16, 16);
+  EXPECT_EQ(one, plain) << "the ring lies beyond a single scale's 5 px";
+  s.ao_scales = 3;  // 5, 10, 20 px
+  const auto three = pixel(shade(ring, s), 16, 16);
+  std::printf("centre luminance %.1f with 1 scale, %.1f with 3\n", luminance(one), luminance(three));
+  EXPECT_LT(luminance(three), 0.9 * luminance(one));
+  // Per pixel, each added scale darkens or keeps every pixel (the factors
+  // multiply and the blur is linear with the same weights).
+  std::vector<Texel> scene = surroundedPixel(2.0);
+  for (const Texel& t : ring)
+    if (t.fiber == 2 && (t.x < 4 || t.x >= 29 || t.y < 4 || t.y >= 29)) scene.push_back({t.x, t.y, t.tangent, 97.0, 3});
+  std::vector<uint8_t> previous;
+  for (int scales = 1; scales <= 4; ++scales) {
+    s.ao_scales = scales;
+    const std::vector<uint8_t> rgba = shade(scene, s);
+    if (!previous.empty()) {
+      for (size_t i = 0; i < rgba.size(); ++i) ASSERT_LE(rgba[i], previous[i]) << scales << " scales, byte " << i;
+    }
+    previous = rgba;
+  }
+  s.ao_scales = 0;
+  EXPECT_THROW(shade({}, s), Error);
+  s.ao_scales = 5;
+  EXPECT_THROW(shade({}, s), Error);
+}
+
+TEST_F(GpuShade, viewerSettingsOutOfRangeAreRejected) {
+  RenderSettings s;
+  s.scalar_min = 2.0f;
+  s.scalar_max = 1.0f;
+  EXPECT_THROW(shade({}, s), Error);
+  s = {};
+  s.scalar_max = std::numeric_limits<float>::infinity();
+  EXPECT_THROW(shade({}, s), Error);
+  s = {};
+  s.dim_unselected = 1.5f;
+  EXPECT_THROW(shade({}, s), Error);
+  s = {};
+  s.highlight_color = {0.5f, -0.1f, 0.5f};
+  EXPECT_THROW(shade({}, s), Error);
+}
+
+TEST_F(GpuShade, wholePhantomFramesInTheViewerModesAreShadedAndTimed) {
+  const Tractogram fibers = phantom(300, 5);
+  const TractogramUpload upload = uploadTractogram(context(), fibers, "phantom");
+  constexpr uint32_t kFrame = 128;
+  FrameRenderer renderer(context(), kFrame, kFrame);
+  const Camera camera = standardView(tractogramBounds(fibers), StandardView::Coronal, kFrame, kFrame);
+  GpuScene scene{&upload.dataset};
+  scene.fiber_scalars = upload.dataset.fiberLength().address;  // colour by length, no extra upload
+  GpuFiberAttributes attributes(context(), fibers.streamlineCount());
+  std::vector<uint32_t> words(selectionWordCount(fibers.streamlineCount()), 0);
+  for (uint32_t f = 0; f < fibers.streamlineCount(); f += 10) words[f / 32] |= 1u << (f % 32);
+  attributes.uploadSelection(words);
+  RenderSettings s;
+  s.culling = CullingMode::None;
+  s.scalar_min = 0.0f;
+  s.scalar_max = 150.0f;
+  s.ao_scales = 3;
+  for (ColorMode mode : {ColorMode::Scalar, ColorMode::Normal})
+    for (bool fxaa : {false, true})
+      for (bool selection : {false, true}) {
+        SCOPED_TRACE(std::string(colorModeName(mode)) + (fxaa ? " fxaa" : "") + (selection ? " selection" : ""));
+        s.color = mode;
+        s.fxaa = fxaa;
+        scene.selection_bits = selection ? attributes.selection() : 0;
+        const FrameStats stats = renderer.render(camera, s, scene);
+        bool timed_fxaa = false;
+        for (const PassTiming& p : stats.passes) timed_fxaa |= p.name == "fxaa";
+        EXPECT_EQ(timed_fxaa, fxaa);
+        const std::vector<uint8_t> rgba = downloadColor(context(), renderer.targets());
+        std::set<uint32_t> colors;
+        for (size_t i = 0; i < rgba.size(); i += 4)
+          colors.insert(uint32_t(rgba[i]) | uint32_t(rgba[i + 1]) << 8 | uint32_t(rgba[i + 2]) << 16);
+        EXPECT_GT(colors.size(), 30u);
+      }
 }
 
 }  // namespace
