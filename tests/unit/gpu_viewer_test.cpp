@@ -1,0 +1,367 @@
+// `fibscope view` as a user and a script meet it: offscreen and (under Xvfb)
+// windowed runs that write a screenshot with the tractogram and the panels,
+// a scripted session through the same actions as the mouse and panels, and
+// one-line errors for malformed scripts. The script parser and the input
+// mapping are pure and tested without a GPU.
+#include <gtest/gtest.h>
+#include <zlib.h>
+
+#include <GLFW/glfw3.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "app/viewer/viewer_input.h"
+#include "app/viewer/viewer_script.h"
+#include "core/error.h"
+#include "test_support.h"
+
+namespace fibscope {
+namespace {
+
+// --- the script parser (no GPU) ---------------------------------------------
+
+TEST(ViewerScript, parsesEveryCommandSkippingCommentsAndBlankLines) {
+  const auto steps = parseScript(
+      "# a session\n"
+      "orbit 10 -5\n"
+      "\n"
+      "pan 3 4   # drag\n"
+      "dolly -2.5\n"
+      "view axial\n"
+      "view reset\n"
+      "fov 45\n"
+      "set color solid\n"
+      "set background 0.1,0.2,0.3\n"
+      "wait 3\n"
+      "screenshot out.png 64x48\n"
+      "screenshot shown.png\n"
+      "quit\n",
+      "s.txt");
+  ASSERT_EQ(steps.size(), 12u);
+  EXPECT_EQ(steps[0].line, 2);
+  const auto& orbit = std::get<OrbitAction>(std::get<ViewerAction>(steps[0].command));
+  EXPECT_EQ(orbit.dx, 10);
+  EXPECT_EQ(orbit.dy, -5);
+  EXPECT_EQ(steps[1].line, 4);
+  EXPECT_EQ(std::get<PanAction>(std::get<ViewerAction>(steps[1].command)).dy, 4);
+  EXPECT_EQ(std::get<DollyAction>(std::get<ViewerAction>(steps[2].command)).steps, -2.5);
+  EXPECT_EQ(std::get<ViewAction>(std::get<ViewerAction>(steps[3].command)).view, StandardView::Axial);
+  EXPECT_FALSE(std::get<ViewAction>(std::get<ViewerAction>(steps[4].command)).view.has_value());
+  EXPECT_EQ(std::get<FovAction>(std::get<ViewerAction>(steps[5].command)).degrees, 45);
+  EXPECT_EQ(std::get<SetAction>(std::get<ViewerAction>(steps[6].command)).value, "solid");
+  EXPECT_EQ(std::get<WaitFrames>(steps[8].command).frames, 3u);
+  const auto& shot = std::get<ScreenshotAction>(std::get<ViewerAction>(steps[9].command));
+  EXPECT_EQ(shot.path, "out.png");
+  EXPECT_EQ(shot.width, 64u);
+  EXPECT_EQ(shot.height, 48u);
+  EXPECT_EQ(std::get<ScreenshotAction>(std::get<ViewerAction>(steps[10].command)).width, 0u);
+  EXPECT_TRUE(std::holds_alternative<QuitAction>(std::get<ViewerAction>(steps[11].command)));
+}
+
+TEST(ViewerScript, malformedLinesNameTheFileAndLine) {
+  for (const std::string bad :
+       {"orbit 1", "orbit a b", "pan 1 2 3", "dolly", "view top", "fov 5", "fov 120", "set color red",
+        "set width 9", "set ssao maybe", "set background 2,0,0", "set speed 3", "wait 0", "wait 1.5",
+        "screenshot out.jpg", "screenshot out.png 0x5", "quit now", "jump 3", "orbit nan 1"}) {
+    SCOPED_TRACE(bad);
+    try {
+      parseScript("view axial\n# fine\n" + bad + "\nquit\n", "session.txt");
+      ADD_FAILURE() << "no error";
+    } catch (const Error& e) {
+      const std::string message = e.what();
+      EXPECT_EQ(message.rfind("session.txt:3: ", 0), 0u) << message;
+      EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    }
+  }
+}
+
+TEST(ViewerScript, settingsApplyOnlyWhenValid) {
+  RenderSettings s;
+  applySetting(s, "pipeline", "lines");
+  applySetting(s, "culling", "none");
+  applySetting(s, "lighting", "none");
+  applySetting(s, "width", "2.5");
+  applySetting(s, "ssao", "off");
+  EXPECT_EQ(s.pipeline, RenderPipeline::Lines);
+  EXPECT_EQ(s.culling, CullingMode::None);
+  EXPECT_EQ(s.lighting, Lighting::None);
+  EXPECT_EQ(s.line_width_px, 2.5f);
+  EXPECT_FALSE(s.ssao);
+  EXPECT_THROW(applySetting(s, "width", "0.5"), Error);
+  EXPECT_EQ(s.line_width_px, 2.5f);  // unchanged by the failure
+}
+
+TEST(ViewerScript, runnerHoldsEachWaitForItsFrames) {
+  ScriptRunner runner(parseScript("orbit 1 0\nwait 2\ndolly 1\nview axial\nwait 1\nquit\n", "s"));
+  EXPECT_EQ(runner.nextFrame().size(), 1u);  // orbit, then the first waited frame
+  EXPECT_EQ(runner.nextFrame().size(), 0u);  // the second
+  EXPECT_EQ(runner.nextFrame().size(), 2u);  // dolly, view; then wait 1
+  EXPECT_FALSE(runner.finished());
+  const auto last = runner.nextFrame();
+  ASSERT_EQ(last.size(), 1u);
+  EXPECT_TRUE(std::holds_alternative<QuitAction>(last[0]));
+  EXPECT_TRUE(runner.finished());
+}
+
+// --- the input mapping (no GPU) ---------------------------------------------
+
+InputEvent cursor(double x, double y) {
+  InputEvent e;
+  e.type = InputEvent::Type::CursorMoved;
+  e.x = x;
+  e.y = y;
+  return e;
+}
+InputEvent button(int b, bool pressed, bool shift = false) {
+  InputEvent e;
+  e.type = InputEvent::Type::MouseButton;
+  e.button = b;
+  e.pressed = pressed;
+  e.shift = shift;
+  return e;
+}
+InputEvent key(int k) {
+  InputEvent e;
+  e.type = InputEvent::Type::Key;
+  e.key = k;
+  e.pressed = true;
+  return e;
+}
+
+TEST(ViewerInput, dragsOrbitPanAndWheelDolliesAsMrview) {
+  InputMapper m;
+  EXPECT_TRUE(m.map(cursor(100, 100), false, false).empty());
+  EXPECT_TRUE(m.map(button(InputEvent::kLeft, true), false, false).empty());
+  auto a = m.map(cursor(110, 95), false, false);
+  ASSERT_EQ(a.size(), 1u);
+  EXPECT_EQ(std::get<OrbitAction>(a[0]).dx, 10);
+  EXPECT_EQ(std::get<OrbitAction>(a[0]).dy, -5);
+  m.map(button(InputEvent::kLeft, false), false, false);
+  EXPECT_TRUE(m.map(cursor(120, 95), false, false).empty());  // released: no drag
+
+  m.map(button(InputEvent::kMiddle, true), false, false);
+  a = m.map(cursor(125, 97), false, false);
+  ASSERT_EQ(a.size(), 1u);
+  EXPECT_EQ(std::get<PanAction>(a[0]).dx, 5);
+  m.map(button(InputEvent::kMiddle, false), false, false);
+
+  m.map(button(InputEvent::kLeft, true, /*shift=*/true), false, false);
+  a = m.map(cursor(126, 97), false, false);
+  ASSERT_EQ(a.size(), 1u);
+  EXPECT_TRUE(std::holds_alternative<PanAction>(a[0]));
+  m.map(button(InputEvent::kLeft, false), false, false);
+
+  InputEvent wheel;
+  wheel.type = InputEvent::Type::Scroll;
+  wheel.y = 2;
+  a = m.map(wheel, false, false);
+  ASSERT_EQ(a.size(), 1u);
+  EXPECT_EQ(std::get<DollyAction>(a[0]).steps, 2);
+}
+
+TEST(ViewerInput, imguiGetsTheMouseFirst) {
+  InputMapper m;
+  m.map(cursor(10, 10), true, false);
+  m.map(button(InputEvent::kLeft, true), /*want_mouse=*/true, false);  // a press on a panel
+  EXPECT_TRUE(m.map(cursor(40, 10), false, false).empty());          // stays with the panel
+  InputEvent wheel;
+  wheel.type = InputEvent::Type::Scroll;
+  wheel.y = 1;
+  EXPECT_TRUE(m.map(wheel, true, false).empty());
+}
+
+TEST(ViewerInput, keysSelectStandardViewsResetAndScreenshot) {
+  InputMapper m;
+  const std::pair<int, std::optional<StandardView>> views[] = {
+      {GLFW_KEY_1, StandardView::Sagittal}, {GLFW_KEY_S, StandardView::Sagittal},
+      {GLFW_KEY_2, StandardView::Coronal},  {GLFW_KEY_C, StandardView::Coronal},
+      {GLFW_KEY_3, StandardView::Axial},    {GLFW_KEY_A, StandardView::Axial},
+      {GLFW_KEY_R, std::nullopt}};
+  for (const auto& [k, view] : views) {
+    const auto a = m.map(key(k), false, false);
+    ASSERT_EQ(a.size(), 1u);
+    EXPECT_EQ(std::get<ViewAction>(a[0]).view, view);
+  }
+  for (int k : {GLFW_KEY_F12, GLFW_KEY_P}) {
+    const auto a = m.map(key(k), false, false);
+    ASSERT_EQ(a.size(), 1u);
+    EXPECT_TRUE(std::holds_alternative<ScreenshotAction>(a[0]));
+  }
+  EXPECT_TRUE(m.map(key(GLFW_KEY_1), false, /*want_keyboard=*/true).empty());  // typing in a panel
+}
+
+// --- the viewer (Vulkan) ---------------------------------------------------
+
+struct Png {
+  uint32_t width = 0, height = 0;
+  std::vector<uint8_t> rgba;
+  const uint8_t* at(uint32_t x, uint32_t y) const { return &rgba[(size_t(y) * width + x) * 4]; }
+};
+
+// Decodes the PNGs writePngRgba writes (8-bit RGBA, filter 0 on every row);
+// anything else is a test failure (empty result).
+Png readOurPng(const std::string& path) {
+  const std::string bytes = test::readBytes(path);
+  Png png;
+  if (bytes.size() < 8 || bytes.compare(0, 8, "\x89PNG\r\n\x1a\n") != 0) return png;
+  auto be32 = [&](size_t at) {
+    return uint32_t(uint8_t(bytes[at])) << 24 | uint32_t(uint8_t(bytes[at + 1])) << 16 |
+           uint32_t(uint8_t(bytes[at + 2])) << 8 | uint32_t(uint8_t(bytes[at + 3]));
+  };
+  std::string idat;
+  uint32_t w = 0, h = 0;
+  for (size_t at = 8; at + 12 <= bytes.size();) {
+    const uint32_t length = be32(at);
+    const std::string type = bytes.substr(at + 4, 4);
+    if (at + 12 + length > bytes.size()) return png;
+    if (type == "IHDR") {
+      w = be32(at + 8);
+      h = be32(at + 12);
+      if (bytes[at + 16] != 8 || bytes[at + 17] != 6) return png;
+    }
+    if (type == "IDAT") idat += bytes.substr(at + 8, length);
+    at += 12 + length;
+  }
+  std::vector<uint8_t> raw(size_t(h) * (1 + size_t(w) * 4));
+  uLongf raw_size = uLongf(raw.size());
+  if (w == 0 || uncompress(raw.data(), &raw_size, reinterpret_cast<const Bytef*>(idat.data()), uLong(idat.size())) !=
+                    Z_OK ||
+      raw_size != raw.size())
+    return png;
+  png.rgba.reserve(size_t(w) * h * 4);
+  for (uint32_t y = 0; y < h; ++y) {
+    const uint8_t* row = &raw[size_t(y) * (1 + size_t(w) * 4)];
+    if (row[0] != 0) return Png{};
+    png.rgba.insert(png.rgba.end(), row + 1, row + 1 + size_t(w) * 4);
+  }
+  png.width = w;
+  png.height = h;
+  return png;
+}
+
+// Pixels in [x0, x1) x [y0, y1) brighter than the black background.
+double coverage(const Png& png, uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1) {
+  size_t lit = 0;
+  for (uint32_t y = y0; y < y1; ++y)
+    for (uint32_t x = x0; x < x1; ++x) {
+      const uint8_t* p = png.at(x, y);
+      if (std::max({p[0], p[1], p[2]}) > 40) ++lit;
+    }
+  return double(lit) / double((x1 - x0) * (y1 - y0));
+}
+
+// The ImGui menu bar along the top: a grey band (style colour MenuBarBg)
+// over the whole width, a few rows down.
+double menuBarShare(const Png& png) {
+  size_t grey = 0;
+  for (uint32_t x = 0; x < png.width; ++x) {
+    const uint8_t* p = png.at(x, 3);
+    if (p[0] > 20 && p[0] < 60 && std::abs(p[0] - p[1]) < 6 && std::abs(p[1] - p[2]) < 6) ++grey;
+  }
+  return double(grey) / png.width;
+}
+
+int lineCount(const std::string& s) { return int(std::count(s.begin(), s.end(), '\n')); }
+
+// LeakSanitizer off in the child: see gpu_cli_render_test.cpp.
+test::CommandResult runViewer(const std::string& args, const std::string& prefix = "") {
+  return test::runCommand(prefix + "ASAN_OPTIONS=\"${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0\" " + FIBSCOPE_EXE +
+                          " view --validate --phantom-streamlines 300 " + args);
+}
+
+class GpuViewer : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto r = test::runCommand(std::string("ASAN_OPTIONS=detect_leaks=0 ") + FIBSCOPE_EXE + " gpu-info");
+    if (r.exit_code != 0) GTEST_SKIP() << "no usable Vulkan device: " << r.output;
+  }
+  // The scene (right half below the overlay) shows the tractogram, the
+  // panels are drawn.
+  static void expectSceneAndPanels(const Png& png) {
+    ASSERT_EQ(png.width, 320u);
+    ASSERT_EQ(png.height, 200u);
+    EXPECT_GT(coverage(png, 160, 130, 320, 200), 0.02);
+    EXPECT_GT(menuBarShare(png), 0.8);
+  }
+  test::TempDir dir_;
+};
+
+TEST_F(GpuViewer, offscreenRunWritesTheWindowWithTractogramAndPanels) {
+  const std::string png = dir_.file("x.png");
+  const auto r = runViewer("--offscreen --size 320x200 --frames 3 --screenshot " + png);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  expectSceneAndPanels(readOurPng(png));
+}
+
+TEST_F(GpuViewer, windowedRunUnderXvfbPresentsThroughASwapchain) {
+  if (test::runCommand("command -v xvfb-run").exit_code != 0) GTEST_SKIP() << "xvfb-run is not installed";
+  const std::string png = dir_.file("x.png");
+  // -a: a free display number (tests may run in parallel).
+  const auto r = runViewer("--size 320x200 --frames 3 --screenshot " + png,
+                           "xvfb-run -a -s '-screen 0 640x480x24' env ");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output.find("offscreen"), std::string::npos) << "no window was made: " << r.output;
+  expectSceneAndPanels(readOurPng(png));
+}
+
+TEST_F(GpuViewer, scriptedSessionRunsCleanUnderValidation) {
+  const std::string script = dir_.file("session.txt");
+  const std::string scene_png = dir_.file("scene.png"), shown_png = dir_.file("shown.png");
+  test::writeBytes(script,
+                   "# camera moves, mode changes, standard views\n"
+                   "orbit 40 10\n"
+                   "pan 5 -3\n"
+                   "dolly 2\n"
+                   "wait 2\n"
+                   "view sagittal\n"
+                   "set color fiber\n"
+                   "set lighting none\n"
+                   "set culling frustum\n"
+                   "wait 1\n"
+                   "view axial\n"
+                   "set pipeline raw-compute\n"
+                   "set ssao off\n"
+                   "fov 40\n"
+                   "wait 1\n"
+                   "set pipeline compute\n"
+                   "view reset\n"
+                   "screenshot " + scene_png + " 96x64\n"
+                   "screenshot " + shown_png + "\n"
+                   "wait 1\n"
+                   "quit\n");
+  const auto r = runViewer("--offscreen --size 320x200 --script " + script);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Png scene = readOurPng(scene_png);
+  ASSERT_EQ(scene.width, 96u);
+  ASSERT_EQ(scene.height, 64u);
+  EXPECT_GT(coverage(scene, 0, 0, 96, 64), 0.05);  // the scene alone, no panels
+  EXPECT_LT(menuBarShare(scene), 0.5);
+  const Png shown = readOurPng(shown_png);
+  EXPECT_EQ(shown.width, 320u);
+  EXPECT_GT(menuBarShare(shown), 0.8);
+}
+
+TEST_F(GpuViewer, malformedScriptLineIsAOneLineErrorWithItsLineNumber) {
+  const std::string script = dir_.file("bad.txt");
+  test::writeBytes(script, "orbit 1 2\n\nview upside-down\n");
+  const auto r = runViewer("--offscreen --size 64x64 --script " + script);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_EQ(lineCount(r.output), 1) << r.output;
+  EXPECT_NE(r.output.find(script + ":3:"), std::string::npos) << r.output;
+}
+
+TEST_F(GpuViewer, badOptionsAreOneLineErrors) {
+  for (const std::string options : {"--size 0x10", "--screenshot x.jpg", "--color red", "--script /nonexistent"}) {
+    SCOPED_TRACE(options);
+    const auto r = runViewer("--offscreen " + options);
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_EQ(lineCount(r.output), 1) << r.output;
+  }
+}
+
+}  // namespace
+}  // namespace fibscope
