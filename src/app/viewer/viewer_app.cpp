@@ -41,6 +41,10 @@ class ViewerApp {
   void run();
 
  private:
+  // Everything after the context: swapchain, presentation, UI, renderer,
+  // the frame's command buffer and fence, the models.
+  void createFrameObjects();
+  void release();
   void apply(const ViewerAction& action);
   void openModel(const std::string& path);
   void frameActiveModel();
@@ -108,7 +112,15 @@ ViewerApp::ViewerApp(const ViewerOptions& options) : options_(options) {
     context_options.surface_factory = [window](VkInstance instance) { return window->createSurface(instance); };
   }
   context_ = std::make_unique<gpu::VulkanContext>(context_options);
+  try {
+    createFrameObjects();
+  } catch (...) {
+    release();
+    throw;
+  }
+}
 
+void ViewerApp::createFrameObjects() {
   uint32_t width = options_.width, height = options_.height;
   if (window_) {
     window_->framebufferSize(width, height);
@@ -138,7 +150,9 @@ ViewerApp::ViewerApp(const ViewerOptions& options) : options_(options) {
   frameActiveModel();
 }
 
-ViewerApp::~ViewerApp() {
+ViewerApp::~ViewerApp() { release(); }
+
+void ViewerApp::release() {
   if (!context_) return;
   vkDeviceWaitIdle(context_->device());
   imgui_.reset();
@@ -149,6 +163,8 @@ ViewerApp::~ViewerApp() {
   if (swapchain_.swapchain != VK_NULL_HANDLE) gpu::destroySwapchain(*context_, swapchain_);
   if (fence_ != VK_NULL_HANDLE) vkDestroyFence(context_->device(), fence_, nullptr);
   if (cmd_ != VK_NULL_HANDLE) vkFreeCommandBuffers(context_->device(), context_->commandPool(), 1, &cmd_);
+  fence_ = VK_NULL_HANDLE;
+  cmd_ = VK_NULL_HANDLE;
   context_.reset();
 }
 
