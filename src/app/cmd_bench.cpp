@@ -104,7 +104,8 @@ void runBench(const BenchOptions& o) {
   scene_options.phantom_streamlines = o.render.phantom_streamlines;
   scene_options.upload_raw = need_points;
   LoadedScene scene = loadScene(*context, scene_options);
-  const GpuScene gpu_scene = scene.gpuScene();
+  GpuScene gpu_scene = scene.gpuScene();
+  for (Variant& v : variants) applyScalarColoring(*context, scene.fiblets, o.render, v.settings, gpu_scene);
 
   // One renderer per variant: two-phase culling keeps the previous frame's
   // visibility, which must be its own.

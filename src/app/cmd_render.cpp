@@ -60,7 +60,7 @@ void runRender(const RenderCommandOptions& o) {
   if (o.output.size() < 5 || o.output.substr(o.output.size() - 4) != ".png")
     throw Error("-o: the output must be a .png file, got '" + o.output + "'");
   if (!o.view.empty() && !o.camera.empty()) throw Error("--view and --camera: give one of them");
-  const RenderSettings settings = renderSettingsFrom(o.render);
+  RenderSettings settings = renderSettingsFrom(o.render);
   uint32_t width = 0, height = 0;
   parseFrameSize(o.render.size, width, height);
 
@@ -71,13 +71,15 @@ void runRender(const RenderCommandOptions& o) {
   scene_options.upload_raw = settings.pipeline != RenderPipeline::Compute;
   LoadedScene scene = loadScene(*context, scene_options);
 
+  GpuScene gpu_scene = scene.gpuScene();
+  applyScalarColoring(*context, scene.fiblets, o.render, settings, gpu_scene);
   const Camera camera = cameraFor(o, scene, width, height);
   auto t = Clock::now();
   FrameStats stats;
   std::vector<uint8_t> rgba;
   {
     FrameRenderer renderer(*context, width, height);
-    stats = renderer.render(camera, settings, scene.gpuScene());
+    stats = renderer.render(camera, settings, gpu_scene);
     rgba = downloadColor(*context, renderer.targets());
   }
   const double frame_seconds = secondsSince(t);

@@ -1,7 +1,10 @@
 #include "app/render_options.h"
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <vector>
 
 #include "core/error.h"
 
@@ -14,9 +17,15 @@ void addRenderCliOptions(CLI::App* cmd, RenderCliOptions& o) {
   cmd->add_option("--size", o.size, "Frame size WxH in pixels")->capture_default_str();
   cmd->add_option("--pipeline", o.pipeline, "compute | lines | raw-compute")->capture_default_str();
   cmd->add_option("--culling", o.culling, "none | frustum | two-phase (compute pipeline)")->capture_default_str();
-  cmd->add_option("--color", o.color, "orientation | solid | fiber")->capture_default_str();
+  cmd->add_option("--color", o.color, "orientation | solid | fiber | scalar (fiber length) | normal")
+      ->capture_default_str();
+  cmd->add_option("--colormap", o.colormap, "viridis | magma | grayscale | coolwarm (--color scalar)")
+      ->capture_default_str();
+  cmd->add_option("--scalar-range", o.scalar_range, "MIN,MAX mapped onto the colormap (default: the data's range)");
   cmd->add_option("--lighting", o.lighting, "illuminated | none")->capture_default_str();
   cmd->add_flag("--no-ssao", o.no_ssao, "No screen-space ambient occlusion");
+  cmd->add_option("--ao-scales", o.ao_scales, "Multi-scale AO: 1 to 4 radii (r, 2r, 4r, 8r)")->capture_default_str();
+  cmd->add_flag("--fxaa", o.fxaa, "Fast approximate anti-aliasing of the image");
   cmd->add_option("--line-width", o.line_width, "Line width in pixels, 1 to 4")->capture_default_str();
   cmd->add_option("--background", o.background, "Background colour R,G,B in [0, 1]")->capture_default_str();
   cmd->add_option("--device", o.device, "Vulkan device whose name contains this");
@@ -40,6 +49,20 @@ RenderSettings renderSettingsFrom(const RenderCliOptions& o) {
   s.color = parseColorMode(o.color);
   s.lighting = parseLighting(o.lighting);
   s.ssao = !o.no_ssao;
+  if (o.ao_scales < 1 || o.ao_scales > 4)
+    throw Error("--ao-scales: expected 1 to 4, got " + std::to_string(o.ao_scales));
+  s.ao_scales = o.ao_scales;
+  s.fxaa = o.fxaa;
+  s.colormap = parseColormap(o.colormap);
+  if (!o.scalar_range.empty()) {
+    float lo = 0, hi = 0;
+    char rest = 0;
+    if (std::sscanf(o.scalar_range.c_str(), "%f,%f%c", &lo, &hi, &rest) != 2 || !std::isfinite(lo) ||
+        !std::isfinite(hi) || hi < lo)
+      throw Error("--scalar-range: expected MIN,MAX with MIN <= MAX, got '" + o.scalar_range + "'");
+    s.scalar_min = lo;
+    s.scalar_max = hi;
+  }
   if (!(o.line_width >= 1.0f && o.line_width <= 4.0f))
     throw Error("--line-width: expected 1 to 4 pixels, got " + std::to_string(o.line_width));
   s.line_width_px = o.line_width;
@@ -50,6 +73,27 @@ RenderSettings renderSettingsFrom(const RenderCliOptions& o) {
     throw Error("--background: expected R,G,B with each in [0, 1], got '" + o.background + "'");
   s.background = {r, g, b};
   return s;
+}
+
+void applyScalarColoring(const gpu::VulkanContext& context, const GpuDataset& dataset, const RenderCliOptions& o,
+                         RenderSettings& settings, GpuScene& scene) {
+  if (settings.color != ColorMode::Scalar) return;
+  const uint32_t fibers = dataset.block().fiber_count;
+  if (fibers == 0) return;
+  scene.fiber_scalars = dataset.fiberLength().address;
+  if (!o.scalar_range.empty()) return;
+  std::vector<float> lengths(fibers);
+  gpu::downloadFromBuffer(context, dataset.fiberLength(), lengths.data(), lengths.size() * sizeof(float));
+  // Finite lengths only: a damaged table must not make the range NaN.
+  float lo = INFINITY, hi = -INFINITY;
+  for (float v : lengths)
+    if (std::isfinite(v)) {
+      lo = std::min(lo, v);
+      hi = std::max(hi, v);
+    }
+  if (lo > hi) return;  // none finite: the default range stays
+  settings.scalar_min = lo;
+  settings.scalar_max = hi;
 }
 
 std::unique_ptr<gpu::VulkanContext> createRenderContext(const RenderCliOptions& o) {
