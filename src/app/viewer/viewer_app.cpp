@@ -438,7 +438,7 @@ void ViewerApp::run() {
         for (const ViewerAction& action : input_.map(event, imgui_->wantsMouse(), imgui_->wantsKeyboard()))
           apply(action);
     for (const ViewerAction& action : script_.nextFrame()) apply(action);
-    if (quit_) break;
+    // A quit still draws this frame: a screenshot asked for with it is taken.
     controller_.update(dt);
 
     if (drawFrame(width, height, dt)) ++frames_done;
