@@ -55,11 +55,18 @@ if [ "$mode" = run ]; then
   ./build/fibscope info out/phantom.tck
   # The fiblet compression of it, with the report (size, error, speed).
   ./build/fibscope compress out/phantom.tck out/phantom.fbl --report --force
-  # The renderer, headless (the interactive viewer is not built yet): the
-  # phantom compressed on the fly and drawn by the compute pipeline, lit,
-  # to a 1920x1080 PNG (lavapipe runs it on the CPU where there is no GPU).
-  ./build/fibscope render out/phantom.tck -o out/phantom.png
-  echo "setup: wrote out/phantom.png"
+  # The main job: the viewer on the built-in phantom where there is a display;
+  # without one, the same renderer headless: the phantom compressed on the fly
+  # and drawn by the compute pipeline, lit, to a 1920x1080 PNG (lavapipe runs
+  # it on the CPU where there is no GPU).
+  if [ -n "${DISPLAY:-}${WAYLAND_DISPLAY:-}" ]; then
+    echo "setup: opening the viewer on the built-in phantom (close the window to end)"
+    ./build/fibscope view
+  else
+    echo "setup: no display: rendering headless instead of opening the viewer"
+    ./build/fibscope render out/phantom.tck -o out/phantom.png
+    echo "setup: wrote out/phantom.png"
+  fi
   exit 0
 fi
 
