@@ -267,10 +267,20 @@ double menuBarShare(const Png& png) {
 
 int lineCount(const std::string& s) { return int(std::count(s.begin(), s.end(), '\n')); }
 
+// The .fbl cache of the viewer runs (the phantom goes through it too): one
+// directory per test process unless a test names its own, never the
+// user's cache.
+const std::string& processCacheDir() {
+  static const test::TempDir dir;
+  return dir.path();
+}
+
 // LeakSanitizer off in the child: see gpu_cli_render_test.cpp.
-test::CommandResult runViewer(const std::string& args, const std::string& prefix = "") {
-  return test::runCommand(prefix + "ASAN_OPTIONS=\"${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0\" " + FIBSCOPE_EXE +
-                          " view --validate --phantom-streamlines 300 " + args);
+test::CommandResult runViewer(const std::string& args, const std::string& prefix = "",
+                              const std::string& cache_dir = "") {
+  return test::runCommand(prefix + "ASAN_OPTIONS=\"${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0\" " +
+                          "FIBSCOPE_CACHE_DIR='" + (cache_dir.empty() ? processCacheDir() : cache_dir) + "' " +
+                          FIBSCOPE_EXE + " view --validate --phantom-streamlines 300 " + args);
 }
 
 class GpuViewer : public ::testing::Test {

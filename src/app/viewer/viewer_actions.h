@@ -41,10 +41,13 @@ struct ScreenshotAction {
 struct OpenAction {  // a tractogram file to add to the model list (empty: the built-in phantom)
   std::string path;
 };
+struct CloseModelAction {  // removes a model from the list (index into ViewerState::models)
+  int model = -1;
+};
 struct QuitAction {};
 
 using ViewerAction = std::variant<OrbitAction, PanAction, DollyAction, ViewAction, FovAction, SetAction,
-                                  ScreenshotAction, OpenAction, QuitAction>;
+                                  ScreenshotAction, OpenAction, CloseModelAction, QuitAction>;
 
 // Sets one RenderSettings field from text, as `set KEY VALUE` in a script:
 //   pipeline compute|lines|raw-compute, culling none|frustum|two-phase,

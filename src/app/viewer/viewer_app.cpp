@@ -3,26 +3,35 @@
 #include <imgui.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <future>
 #include <memory>
 #include <optional>
+#include <thread>
 #include <type_traits>
 
-#include "app/render_scene.h"
+#include "app/model_loader.h"
+#include "app/open_input.h"
 #include "app/viewer/imgui_layer.h"
 #include "app/viewer/presentation.h"
+#include "app/viewer/recent_files.h"
 #include "app/viewer/viewer_input.h"
 #include "app/viewer/viewer_script.h"
 #include "app/viewer/viewer_state.h"
 #include "app/viewer/viewer_ui.h"
 #include "app/viewer/viewer_window.h"
+#include "codec/fbl_reader.h"
 #include "core/error.h"
 #include "gpu/submit.h"
 #include "gpu/swapchain.h"
 #include "gpu/vk_check.h"
+#include "phantom/phantom.h"
+#include "render/gpu_dataset.h"
 #include "render/gpu_frame_renderer.h"
+#include "render/gpu_raw_tractogram.h"
 #include "render/orbit_controller.h"
 #include "render/reference_raster.h"
 
@@ -30,6 +39,65 @@ namespace fibscope {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+// One model of the list: what the loader produced (kept whole: exporting
+// selected fibers and the fiber lengths read its .fbl), its fiblets on the
+// device and, once a baseline pipeline asked for them, its raw vertices.
+struct ViewerModel {
+  std::unique_ptr<ModelData> data;
+  GpuDataset fiblets;
+  GpuRawTractogram raw;
+  bool has_raw = false;
+
+  // What a frame of this model draws.
+  GpuScene gpuScene() const { return GpuScene{&fiblets, has_raw ? &raw : nullptr}; }
+};
+
+// A reader that stops at the next chunk once `cancel` is set (a raw decode
+// of a model closed meanwhile, or the viewer quitting).
+class CancelOnFlag final : public TractogramReader {
+ public:
+  CancelOnFlag(std::unique_ptr<TractogramReader> inner, const std::atomic<bool>& cancel)
+      : inner_(std::move(inner)), cancel_(cancel) {
+    header_ = inner_->header();
+  }
+  bool read(Tractogram& chunk, size_t max_points) override {
+    if (cancel_.load(std::memory_order_relaxed)) fail(header_.path.empty() ? "raw vertices" : header_.path, "cancelled");
+    return inner_->read(chunk, max_points);
+  }
+  uint64_t bytesRead() const override { return inner_->bytesRead(); }
+
+ private:
+  std::unique_ptr<TractogramReader> inner_;
+  const std::atomic<bool>& cancel_;
+};
+
+// The baselines' raw vertices of a loaded model, decoded on a thread of
+// their own (CPU only; the upload stays on the main thread): the model's
+// .fbl through openFbl, so fiber ids and points are the compressed file's
+// (what `fibscope decompress` gives). A copy that lives only while mapped
+// (unwritable cache) has no path to reopen: the source is read instead.
+struct RawDecode {
+  const ViewerModel* model = nullptr;
+  std::shared_ptr<std::atomic<bool>> cancel;
+  std::future<Tractogram> points;
+};
+
+Tractogram decodeRawVertices(const std::string& fbl_path, const std::string& source_path, uint64_t phantom_streamlines,
+                             const std::atomic<bool>& cancel) {
+  std::unique_ptr<TractogramReader> inner;
+  if (!fbl_path.empty()) {
+    inner = openFbl(fbl_path);
+  } else if (!source_path.empty()) {
+    inner = openInput(source_path);
+  } else {
+    PhantomOptions phantom;
+    phantom.streamlines = phantom_streamlines;
+    inner = openPhantom(phantom);
+  }
+  CancelOnFlag reader(std::move(inner), cancel);
+  return readAllStreamlines(reader);
+}
 
 class ViewerApp {
  public:
@@ -46,10 +114,22 @@ class ViewerApp {
   void createFrameObjects();
   void release();
   void apply(const ViewerAction& action);
-  void openModel(const std::string& path);
+  // Queues a load on the worker; `at_start`: a command-line file (an error
+  // then ends the run).
+  void openModel(const std::string& path, bool at_start = false);
+  // Finished loads -> uploaded models (main thread, no frame in flight),
+  // errors -> status and the panel; the running job's progress -> state_.
+  void pollLoads();
+  void addModel(LoadEvent& event);
+  void closeModel(int model);
   void frameActiveModel();
-  const LoadedScene* activeScene();
-  bool ensureRawFor(int model);
+  const ViewerModel* activeScene();
+  // The settings a frame of `model` is drawn with: a baseline pipeline
+  // whose raw vertices are still being decoded draws with compute meanwhile.
+  RenderSettings drawSettings(const ViewerModel& model) const;
+  void ensureRawFor(int model);
+  void pollRawDecode();
+  void cancelRawDecode();
   void resizeTo(uint32_t width, uint32_t height);
   // Waits for the frame in flight and records its statistics.
   void finishFrame();
@@ -68,8 +148,16 @@ class ViewerApp {
   std::unique_ptr<ImGuiLayer> imgui_;
   std::unique_ptr<FrameRenderer> renderer_;
   std::unique_ptr<FrameRenderer> shot_renderer_;  // scene-only screenshots at a chosen size
-  std::vector<std::unique_ptr<LoadedScene>> scenes_;  // index-aligned with state_.models
+  std::vector<std::unique_ptr<ViewerModel>> scenes_;  // index-aligned with state_.models
   int framed_model_ = -1;  // the model the camera was last framed on
+  // Loading: one worker (model_loader.h); the jobs named on the command
+  // line not finished yet (frames and the script count once they are).
+  std::unique_ptr<ModelLoader> loader_;
+  std::vector<uint64_t> startup_jobs_;
+  std::vector<std::pair<uint64_t, uint64_t>> job_first_frame_;  // job id, frames_drawn_ when requested
+  std::optional<RawDecode> raw_decode_;
+  std::string recent_files_path_;
+  uint64_t frames_drawn_ = 0;
 
   VkCommandBuffer cmd_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;
@@ -140,20 +228,24 @@ void ViewerApp::createFrameObjects() {
   gpu::throwIfFailed(vkCreateFence(context_->device(), &fence_info, nullptr, &fence_), "vkCreateFence");
 
   controller_.setViewport(width, height);
-  if (options_.files.empty()) openModel("");
-  for (const std::string& file : options_.files) openModel(file);
-  // A file named on the command line that cannot be read ends the run (as
-  // `render` does); from the UI it only shows the error.
-  if (!state_.status.empty() && state_.models.size() < std::max<size_t>(options_.files.size(), 1))
-    throw Error(state_.status);
-  if (!state_.models.empty()) state_.active_model = 0;
-  frameActiveModel();
+  recent_files_path_ = defaultRecentFilesPath();
+  state_.recent_files = loadRecentFiles(recent_files_path_);
+  ModelLoaderOptions loader_options;
+  loader_options.phantom_streamlines = options_.phantom_streamlines;
+  loader_ = std::make_unique<ModelLoader>(loader_options);
+  // Loaded on the worker while frames are drawn; a file named on the
+  // command line that cannot be read ends the run (as `render` does), from
+  // the UI or a script it only shows the error (pollLoads).
+  if (options_.files.empty()) openModel("", true);
+  for (const std::string& file : options_.files) openModel(file, true);
 }
 
 ViewerApp::~ViewerApp() { release(); }
 
 void ViewerApp::release() {
   if (!context_) return;
+  loader_.reset();  // cancels the running job and joins the worker
+  cancelRawDecode();
   vkDeviceWaitIdle(context_->device());
   imgui_.reset();
   shot_renderer_.reset();
@@ -168,67 +260,193 @@ void ViewerApp::release() {
   context_.reset();
 }
 
-void ViewerApp::openModel(const std::string& path) {
-  SceneOptions scene_options;
-  scene_options.path = path;
-  scene_options.phantom_streamlines = options_.phantom_streamlines;
-  scene_options.upload_raw = state_.settings.pipeline != RenderPipeline::Compute;
-  scene_options.progress = false;
-  try {
-    const auto start = Clock::now();
-    finishFrame();  // the upload must not race the frame in flight
-    auto scene = std::make_unique<LoadedScene>(loadScene(*context_, scene_options));
-    ModelInfo info;
-    info.name = path.empty() ? scene->name : std::filesystem::path(path).filename().string();
-    info.path = path;
-    info.streamlines = scene->streamlines;
-    info.segments = scene->segments;
-    info.fiblets = scene->fiblets.block().fiblet_count;
-    info.load_seconds = std::chrono::duration<double>(Clock::now() - start).count();
-    state_.models.push_back(info);
-    scenes_.push_back(std::move(scene));
-    state_.active_model = int(state_.models.size()) - 1;
-    state_.status = "opened " + info.name;
-  } catch (const Error& e) {
-    state_.status = e.what();  // one line; the viewer keeps running
-    std::fprintf(stderr, "fibscope view: %s\n", e.what());
+void ViewerApp::openModel(const std::string& path, bool at_start) {
+  const uint64_t id = loader_->request(path);
+  if (at_start) startup_jobs_.push_back(id);
+  job_first_frame_.emplace_back(id, frames_drawn_);
+}
+
+void ViewerApp::pollLoads() {
+  for (LoadEvent& event : loader_->poll()) {
+    const auto at_start = std::find(startup_jobs_.begin(), startup_jobs_.end(), event.id);
+    const bool startup = at_start != startup_jobs_.end();
+    if (startup) startup_jobs_.erase(at_start);
+    if (event.cancelled) continue;
+    if (event.ok()) {
+      try {
+        addModel(event);
+        continue;
+      } catch (const Error& e) {
+        event.error = e.what();  // the upload failed (e.g. it does not fit on the device)
+      }
+    }
+    // A command-line file ends the run with its one-line error (exit 2).
+    if (startup) throw Error(event.error);
+    state_.status = event.error;
+    state_.load_failures.push_back(LoadFailure{event.path, event.error});
+    std::fprintf(stderr, "fibscope view: %s\n", event.error.c_str());
   }
+  state_.loading.clear();
+  const size_t pending = loader_->pending();
+  for (const LoadProgress& p : loader_->progress()) {
+    LoadingInfo info;
+    info.path = p.path;
+    info.label = p.snapshot.label;
+    info.unit = p.snapshot.unit;
+    info.done = p.snapshot.done;
+    info.total = p.snapshot.total;
+    info.rate = p.snapshot.rate;
+    info.eta_seconds = p.snapshot.eta_seconds;
+    info.elapsed_seconds = p.snapshot.elapsed_seconds;
+    info.queued = pending > 0 ? pending - 1 : 0;
+    state_.loading.push_back(std::move(info));
+  }
+  if (state_.loading.empty() && pending > 0) {  // queued, not started yet
+    LoadingInfo info;
+    info.label = "queued";
+    info.queued = pending - 1;
+    state_.loading.push_back(std::move(info));
+  }
+}
+
+void ViewerApp::addModel(LoadEvent& event) {
+  ModelData& data = *event.model;
+  for (const std::string& warning : data.warnings)
+    std::fprintf(stderr, "fibscope view: warning: %s\n", warning.c_str());
+  finishFrame();  // the upload must not race the frame in flight
+  const auto start = Clock::now();
+  auto model = std::make_unique<ViewerModel>();
+  model->fiblets = GpuDataset::upload(*context_, data.fbl);
+  const double upload_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+
+  ModelInfo info;
+  info.name = data.name;
+  info.path = data.source_path;
+  info.streamlines = data.streamlines;
+  info.points = data.points;
+  info.segments = data.segments;
+  info.fiblets = data.fiblets;
+  info.step_mm = data.step_mm;
+  info.input_bytes = data.input_bytes;
+  info.fbl_bytes = data.fbl_bytes;
+  info.from_cache = data.from_cache;
+  info.compress_seconds = data.compress_seconds;
+  info.mean_error_um = data.mean_error_um;
+  info.max_error_um = data.max_error_um;
+  info.load_seconds = data.seconds + upload_seconds;
+  model->data = std::move(event.model);
+  state_.models.push_back(info);
+  scenes_.push_back(std::move(model));
+  state_.active_model = int(state_.models.size()) - 1;  // framed by the next drawFrame
+
+  uint64_t frames_meanwhile = 0;
+  for (auto it = job_first_frame_.begin(); it != job_first_frame_.end(); ++it)
+    if (it->first == event.id) {
+      frames_meanwhile = frames_drawn_ - it->second;
+      job_first_frame_.erase(it);
+      break;
+    }
+  // On stderr too, so that scripts and tests see whether compression ran.
+  char line[512];
+  std::snprintf(line, sizeof(line), "opened %s %s in %.2f s (%.2f s in all, %llu frames drawn meanwhile)",
+                info.name.c_str(), info.from_cache ? "from cache" : "compressed",
+                info.from_cache ? info.load_seconds : info.compress_seconds, info.load_seconds,
+                static_cast<unsigned long long>(frames_meanwhile));
+  state_.status = line;
+  std::fprintf(stderr, "fibscope view: %s\n", line);
+
+  if (!info.path.empty()) {
+    state_.recent_files = addRecentFile(std::move(state_.recent_files), info.path);
+    const std::string why_not = saveRecentFiles(recent_files_path_, state_.recent_files);
+    if (!why_not.empty() && !recent_files_path_.empty())
+      std::fprintf(stderr, "fibscope view: warning: recent files not saved: %s\n", why_not.c_str());
+  }
+}
+
+void ViewerApp::closeModel(int model) {
+  if (model < 0 || model >= int(scenes_.size())) return;
+  finishFrame();  // the frame in flight may read the model's buffers
+  if (raw_decode_ && raw_decode_->model == scenes_[size_t(model)].get()) cancelRawDecode();
+  scenes_.erase(scenes_.begin() + model);
+  state_.models.erase(state_.models.begin() + model);
+  auto shift = [&](int& index) {
+    if (index == model) index = -1;
+    else if (index > model) --index;
+  };
+  const bool was_active = state_.active_model == model;
+  shift(state_.active_model);
+  shift(framed_model_);
+  // The next model takes the closed one's place (framed by the next drawFrame).
+  if (was_active && !state_.models.empty()) state_.active_model = std::min(model, int(state_.models.size()) - 1);
 }
 
 void ViewerApp::frameActiveModel() {
   if (state_.active_model < 0) return;
-  const LoadedScene& scene = *scenes_[size_t(state_.active_model)];
-  controller_.frame(scene.bounds, scene.sample);
+  const ModelData& data = *scenes_[size_t(state_.active_model)]->data;
+  controller_.frame(data.bounds, data.sample);
   framed_model_ = state_.active_model;
 }
 
-const LoadedScene* ViewerApp::activeScene() {
+const ViewerModel* ViewerApp::activeScene() {
   const int m = state_.active_model;
   if (m < 0 || m >= int(scenes_.size()) || !state_.models[size_t(m)].visible) return nullptr;
   return scenes_[size_t(m)].get();
 }
 
-// The baselines draw raw vertices: a model opened for the compute pipeline
-// only is read again with them when such a pipeline is chosen.
-bool ViewerApp::ensureRawFor(int model) {
-  if (state_.settings.pipeline == RenderPipeline::Compute || model < 0 || scenes_[size_t(model)]->has_raw)
-    return true;
-  SceneOptions scene_options;
-  scene_options.path = state_.models[size_t(model)].path;
-  scene_options.phantom_streamlines = options_.phantom_streamlines;
-  scene_options.upload_raw = true;
-  scene_options.progress = false;
+RenderSettings ViewerApp::drawSettings(const ViewerModel& model) const {
+  RenderSettings settings = state_.settings;
+  if (settings.pipeline != RenderPipeline::Compute && !model.has_raw) settings.pipeline = RenderPipeline::Compute;
+  return settings;
+}
+
+// The baselines draw raw vertices, decoded when such a pipeline is first
+// chosen for a model: on a thread (pollRawDecode uploads them), the frames
+// going on with the compute pipeline meanwhile.
+void ViewerApp::ensureRawFor(int model) {
+  if (state_.settings.pipeline == RenderPipeline::Compute || model < 0 || model >= int(scenes_.size())) return;
+  const ViewerModel* m = scenes_[size_t(model)].get();
+  if (m->has_raw || (raw_decode_ && raw_decode_->model == m)) return;
+  cancelRawDecode();  // another model's: the active one matters
+  const ModelData& data = *m->data;
+  const std::string fbl_path = data.temporary ? std::string() : data.fbl.path();
+  RawDecode decode;
+  decode.model = m;
+  decode.cancel = std::make_shared<std::atomic<bool>>(false);
+  decode.points = std::async(std::launch::async, [fbl_path, source = data.source_path,
+                                                  phantom = options_.phantom_streamlines, cancel = decode.cancel] {
+    return decodeRawVertices(fbl_path, source, phantom, *cancel);
+  });
+  raw_decode_ = std::move(decode);
+  state_.status = "decoding the raw vertices of " + data.name + " for the " +
+                  std::string(renderPipelineName(state_.settings.pipeline)) + " pipeline (compute meanwhile)";
+}
+
+void ViewerApp::pollRawDecode() {
+  if (!raw_decode_ || raw_decode_->points.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
+  RawDecode decode = std::move(*raw_decode_);
+  raw_decode_.reset();
+  auto it = std::find_if(scenes_.begin(), scenes_.end(), [&](const auto& m) { return m.get() == decode.model; });
   try {
-    finishFrame();
-    vkDeviceWaitIdle(context_->device());
-    scenes_[size_t(model)].reset();
-    scenes_[size_t(model)] = std::make_unique<LoadedScene>(loadScene(*context_, scene_options));
-    return true;
+    Tractogram points = decode.points.get();
+    if (it == scenes_.end()) return;  // closed meanwhile
+    finishFrame();  // the upload must not race the frame in flight
+    ViewerModel& model = **it;
+    model.raw = GpuRawTractogram::upload(*context_, points, model.data->name);
+    model.has_raw = true;
+    state_.status = "raw vertices of " + model.data->name + " ready";
   } catch (const Error& e) {
+    if (it == scenes_.end()) return;
     state_.status = e.what();
-    state_.settings.pipeline = RenderPipeline::Compute;
-    return false;
+    std::fprintf(stderr, "fibscope view: %s\n", e.what());
+    state_.settings.pipeline = RenderPipeline::Compute;  // the baseline cannot draw this model
   }
+}
+
+void ViewerApp::cancelRawDecode() {
+  if (!raw_decode_) return;
+  raw_decode_->cancel->store(true);
+  if (raw_decode_->points.valid()) raw_decode_->points.wait();  // stops at its next chunk
+  raw_decode_.reset();
 }
 
 void ViewerApp::apply(const ViewerAction& action) {
@@ -256,8 +474,9 @@ void ViewerApp::apply(const ViewerAction& action) {
         } else if constexpr (std::is_same_v<A, ScreenshotAction>) {
           takeScreenshot(a);
         } else if constexpr (std::is_same_v<A, OpenAction>) {
-          openModel(a.path);
-          frameActiveModel();
+          openModel(a.path);  // on the worker: framed when it is added
+        } else if constexpr (std::is_same_v<A, CloseModelAction>) {
+          closeModel(a.model);
         } else if constexpr (std::is_same_v<A, QuitAction>) {
           quit_ = true;
         }
@@ -283,12 +502,12 @@ void ViewerApp::takeScreenshot(const ScreenshotAction& shot) {
   try {
     finishFrame();
     controller_.finishAnimation();
-    const LoadedScene* scene = activeScene();
+    const ViewerModel* scene = activeScene();
     if (!scene) throw Error("screenshot: no visible model to draw");
     if (!shot_renderer_) shot_renderer_ = std::make_unique<FrameRenderer>(*context_, shot.width, shot.height);
     shot_renderer_->resize(shot.width, shot.height);
     const Camera camera = controller_.camera(shot.width, shot.height);
-    shot_renderer_->render(camera, state_.settings, scene->gpuScene());
+    shot_renderer_->render(camera, drawSettings(*scene), scene->gpuScene());
     writePngRgba(path, shot.width, shot.height, downloadColor(*context_, shot_renderer_->targets()));
     controller_.setViewport(presentation_.width, presentation_.height);  // camera() noted the shot's size
     state_.status = "saved " + path;
@@ -320,17 +539,20 @@ void ViewerApp::resizeTo(uint32_t width, uint32_t height) {
 }
 
 void ViewerApp::recordFrame(VkCommandBuffer cmd, uint32_t width, uint32_t height, const Camera& camera) {
-  const LoadedScene* scene = activeScene();
+  const ViewerModel* scene = activeScene();
   if (scene) {
-    renderer_->record(cmd, camera, state_.settings, scene->gpuScene());
+    renderer_->record(cmd, camera, drawSettings(*scene), scene->gpuScene());
   } else {
     // Nothing to draw: the background alone (RGBA8, R in the low byte).
     auto byte = [](float v) { return uint32_t(std::clamp(v, 0.0f, 1.0f) * 255.0f + 0.5f); };
     const auto& bg = state_.settings.background;
     const uint32_t packed = byte(bg[0]) | byte(bg[1]) << 8 | byte(bg[2]) << 16 | 0xFF000000u;
     vkCmdFillBuffer(cmd, renderer_->targets().color.buffer, 0, uint64_t(width) * height * 4, packed);
-    gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                       VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    // Read next by the copy into the presentation image (a transfer). All
+    // transfer stages: validation layers file the fill under COPY, the
+    // spec under CLEAR.
+    gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                       VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
   }
   recordCopyColorToPresentation(cmd, renderer_->targets().color, presentation_);
   beginPresentationPass(cmd, presentation_);
@@ -425,6 +647,10 @@ void ViewerApp::run() {
       }
     }
     finishFrame();
+    pollLoads();  // after the fence: uploads run on this thread, nothing in flight
+    pollRawDecode();
+    // Frames and the script count once the models named at start are in.
+    const bool starting = !startup_jobs_.empty();
     const auto now = Clock::now();
     const double dt = std::chrono::duration<double>(now - frame_start_).count();
     last_frame_ms_ = dt * 1000.0;
@@ -437,13 +663,20 @@ void ViewerApp::run() {
       for (const InputEvent& event : window_->takeEvents())
         for (const ViewerAction& action : input_.map(event, imgui_->wantsMouse(), imgui_->wantsKeyboard()))
           apply(action);
-    for (const ViewerAction& action : script_.nextFrame()) apply(action);
+    if (!starting)
+      for (const ViewerAction& action : script_.nextFrame(loader_->busy())) apply(action);
     // A quit still draws this frame: a screenshot asked for with it is taken.
     controller_.update(dt);
 
-    if (drawFrame(width, height, dt)) ++frames_done;
+    if (drawFrame(width, height, dt)) {
+      ++frames_drawn_;
+      if (!starting) ++frames_done;
+    }
+    // Offscreen nothing paces the frames: while a load runs, leave the
+    // cores to the worker (a window is paced by vsync).
+    if (!window_ && loader_->busy()) std::this_thread::sleep_for(std::chrono::milliseconds(10));
     const bool frames_done_enough = options_.frames > 0 && frames_done >= options_.frames;
-    const bool script_done = !script_.empty() && script_.finished();
+    const bool script_done = !script_.empty() && script_.finished() && !starting;
     if (!window_ || options_.frames > 0 || !script_.empty()) {
       // Runs that stop by themselves: after the frames and the script.
       if ((options_.frames == 0 || frames_done_enough) && (script_.empty() || script_done)) break;

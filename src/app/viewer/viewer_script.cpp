@@ -38,7 +38,7 @@ void expectArguments(const std::vector<std::string_view>& words, size_t min, siz
   if (n < min || n > max) throw Error(std::string("expected '") + usage + "', got " + std::to_string(n) + " arguments");
 }
 
-std::variant<ViewerAction, WaitFrames> parseCommand(const std::vector<std::string_view>& w) {
+std::variant<ViewerAction, WaitFrames, WaitLoaded> parseCommand(const std::vector<std::string_view>& w) {
   const std::string_view name = w[0];
   if (name == "orbit" || name == "pan") {
     expectArguments(w, 2, 2, name == "orbit" ? "orbit DX DY" : "pan DX DY");
@@ -81,12 +81,20 @@ std::variant<ViewerAction, WaitFrames> parseCommand(const std::vector<std::strin
     if (w.size() == 3) parseFrameSize(std::string(w[2]), shot.width, shot.height);
     return ViewerAction{shot};
   }
+  if (name == "open") {
+    expectArguments(w, 1, 1, "open PATH");
+    return ViewerAction{OpenAction{std::string(w[1])}};
+  }
+  if (name == "wait-loaded") {
+    expectArguments(w, 0, 0, "wait-loaded");
+    return WaitLoaded{};
+  }
   if (name == "quit") {
     expectArguments(w, 0, 0, "quit");
     return ViewerAction{QuitAction{}};
   }
   throw Error("unknown command '" + std::string(name) +
-              "' (expected orbit, pan, dolly, view, fov, set, wait, screenshot or quit)");
+              "' (expected orbit, pan, dolly, view, fov, set, wait, wait-loaded, open, screenshot or quit)");
 }
 
 }  // namespace
@@ -121,8 +129,12 @@ std::vector<ScriptStep> loadScript(const std::string& path) {
   return parseScript(text.str(), path);
 }
 
-std::vector<ViewerAction> ScriptRunner::nextFrame() {
+std::vector<ViewerAction> ScriptRunner::nextFrame(bool loading) {
   std::vector<ViewerAction> actions;
+  if (waiting_loaded_) {
+    if (loading) return actions;
+    waiting_loaded_ = false;
+  }
   if (waiting_ > 0) {
     --waiting_;
     return actions;
@@ -131,6 +143,12 @@ std::vector<ViewerAction> ScriptRunner::nextFrame() {
     const ScriptStep& step = steps_[next_++];
     if (const auto* wait = std::get_if<WaitFrames>(&step.command)) {
       waiting_ = wait->frames - 1;  // this frame is the first one waited
+      break;
+    }
+    if (std::holds_alternative<WaitLoaded>(step.command)) {
+      // Checked from the next frame on: an `open` just above is requested
+      // when these actions are applied, so the loader is busy by then.
+      waiting_loaded_ = true;
       break;
     }
     actions.push_back(std::get<ViewerAction>(step.command));

@@ -8,6 +8,8 @@
 //   set KEY VALUE               (applySetting)
 //   wait N                      (frames, 1 to 100000)
 //   screenshot OUT.png [WxH]    (WxH: the scene alone at that size)
+//   open PATH                   (loads on the worker; frames go on meanwhile)
+//   wait-loaded                 (holds until no load is queued or running)
 //   quit
 #pragma once
 
@@ -25,9 +27,11 @@ struct WaitFrames {
   uint32_t frames = 1;
 };
 
+struct WaitLoaded {};
+
 struct ScriptStep {
   int line = 0;  // 1-based, for messages
-  std::variant<ViewerAction, WaitFrames> command;
+  std::variant<ViewerAction, WaitFrames, WaitLoaded> command;
 };
 
 // Parses a whole script. `path` only names the script in messages. Throws
@@ -44,15 +48,17 @@ class ScriptRunner {
   explicit ScriptRunner(std::vector<ScriptStep> steps) : steps_(std::move(steps)) {}
 
   // The actions to apply before the next frame: every command up to the
-  // next `wait` (which then holds for its frames), or none while waiting.
-  std::vector<ViewerAction> nextFrame();
-  bool finished() const { return next_ >= steps_.size() && waiting_ == 0; }
+  // next `wait` (which then holds for its frames) or `wait-loaded` (which
+  // holds while `loading`), or none while waiting.
+  std::vector<ViewerAction> nextFrame(bool loading = false);
+  bool finished() const { return next_ >= steps_.size() && waiting_ == 0 && !waiting_loaded_; }
   bool empty() const { return steps_.empty(); }
 
  private:
   std::vector<ScriptStep> steps_;
   size_t next_ = 0;
   uint32_t waiting_ = 0;
+  bool waiting_loaded_ = false;
 };
 
 }  // namespace fibscope

@@ -21,6 +21,32 @@ struct ModelInfo {
   bool visible = true;
   uint64_t streamlines = 0, segments = 0, fiblets = 0;
   double load_seconds = 0;
+  // Statistics of the loaded .fbl (ModelData), for the models panel.
+  uint64_t points = 0;
+  double step_mm = 0;
+  uint64_t input_bytes = 0, fbl_bytes = 0;  // input 0: unknown (phantom)
+  bool from_cache = false;                   // no compression ran
+  double compress_seconds = 0;               // 0 when from_cache
+  double mean_error_um = 0, max_error_um = 0;  // codec error when compressed now
+};
+
+// A load that failed (from the UI or a script): shown in the models panel
+// until dismissed; the message is one line naming the file.
+struct LoadFailure {
+  std::string path;
+  std::string message;
+};
+
+// The running load job, for the progress bar (viewer_ui_models.cpp).
+struct LoadingInfo {
+  std::string path;   // "" = the built-in phantom
+  std::string label;  // the phase: "checking the cache", "compressing", ...
+  double done = 0, total = 0;  // total 0: unknown
+  double rate = 0;             // units per second
+  std::string unit;            // "points", "bytes", ...
+  double eta_seconds = -1;     // -1: unknown
+  double elapsed_seconds = 0;
+  size_t queued = 0;  // further jobs waiting behind this one
 };
 
 // One frame's numbers, kept for the performance overlay's history.
@@ -35,6 +61,10 @@ struct ViewerState {
 
   std::vector<ModelInfo> models;
   int active_model = -1;  // index into models, -1: none
+  // Loading (the frame loop fills these from its ModelLoader).
+  std::vector<LoadingInfo> loading;  // the running job first; empty when idle
+  std::vector<LoadFailure> load_failures;
+  std::vector<std::string> recent_files;  // newest first (recent_files.h)
 
   // Newest last, at most kFrameHistory.
   static constexpr size_t kFrameHistory = 240;

@@ -28,38 +28,6 @@ bool enumCombo(const char* label, Enum& value, int count, NameFn name) {
   return changed;
 }
 
-void modelsPanel(ViewerState& state, std::vector<ViewerAction>& actions) {
-  ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowSize(ImVec2(300, 0), ImGuiCond_FirstUseEver);
-  if (!ImGui::Begin("Models", &state.show_models)) {
-    ImGui::End();
-    return;
-  }
-  for (int i = 0; i < int(state.models.size()); ++i) {
-    ModelInfo& m = state.models[size_t(i)];
-    ImGui::PushID(i);
-    ImGui::Checkbox("##visible", &m.visible);
-    ImGui::SameLine();
-    if (ImGui::Selectable(m.name.c_str(), state.active_model == i)) state.active_model = i;
-    if (state.active_model == i) {
-      ImGui::TextDisabled("%llu streamlines, %llu segments, %llu fiblets",
-                          static_cast<unsigned long long>(m.streamlines),
-                          static_cast<unsigned long long>(m.segments), static_cast<unsigned long long>(m.fiblets));
-      ImGui::TextDisabled("loaded in %.2f s", m.load_seconds);
-    }
-    ImGui::PopID();
-  }
-  if (state.models.empty()) ImGui::TextDisabled("no model");
-  ImGui::Separator();
-  static char path[1024] = "";
-  ImGui::SetNextItemWidth(-60);
-  const bool enter = ImGui::InputTextWithHint("##path", "file.tck / .trk / .trx / .fbl", path, sizeof(path),
-                                              ImGuiInputTextFlags_EnterReturnsTrue);
-  ImGui::SameLine();
-  if ((ImGui::Button("Open") || enter) && path[0] != 0) actions.push_back(OpenAction{path});
-  ImGui::End();
-}
-
 void settingsPanel(ViewerState& state, std::vector<ViewerAction>& actions) {
   ImGui::SetNextWindowPos(ImVec2(10, 200), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowSize(ImVec2(300, 0), ImGuiCond_FirstUseEver);
@@ -189,7 +157,8 @@ std::vector<ViewerAction> drawViewerUi(ViewerState& state) {
     if (ImGui::MenuItem("Screenshot")) actions.push_back(ScreenshotAction{});
     ImGui::EndMainMenuBar();
   }
-  if (state.show_models) modelsPanel(state, actions);
+  if (state.show_models) drawModelsPanel(state, actions);
+  drawLoadingOverlay(state);
   if (state.show_settings) settingsPanel(state, actions);
   if (state.show_performance) performanceOverlay(state);
   statusLine(state);

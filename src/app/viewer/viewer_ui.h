@@ -14,4 +14,10 @@ namespace fibscope {
 
 std::vector<ViewerAction> drawViewerUi(ViewerState& state);
 
+// viewer_ui_models.cpp: the models panel (list, statistics, load progress,
+// failed loads, open with recent files) and the small overlay shown while a
+// load runs.
+void drawModelsPanel(ViewerState& state, std::vector<ViewerAction>& actions);
+void drawLoadingOverlay(const ViewerState& state);
+
 }  // namespace fibscope
