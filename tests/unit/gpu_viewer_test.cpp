@@ -14,9 +14,14 @@
 #include <string>
 #include <vector>
 
+#include "app/viewer/recent_files.h"
 #include "app/viewer/viewer_input.h"
 #include "app/viewer/viewer_script.h"
+#include "codec/compressor.h"
+#include "codec/fbl_reader.h"
 #include "core/error.h"
+#include "io/reader.h"
+#include "phantom/phantom.h"
 #include "test_support.h"
 
 namespace fibscope {
@@ -93,6 +98,46 @@ TEST(ViewerScript, settingsApplyOnlyWhenValid) {
   EXPECT_FALSE(s.ssao);
   EXPECT_THROW(applySetting(s, "width", "0.5"), Error);
   EXPECT_EQ(s.line_width_px, 2.5f);  // unchanged by the failure
+}
+
+TEST(ViewerScript, parsesPickingAndSelectionCommands) {
+  const auto steps = parseScript(
+      "pick 10 20\n"
+      "pick 3.5 4 add\n"
+      "clear-selection\n"
+      "export-selection out.tck\n"
+      "\n"
+      "expect-selected 2\n",
+      "s.txt");
+  ASSERT_EQ(steps.size(), 5u);
+  const auto& pick = std::get<PickAction>(std::get<ViewerAction>(steps[0].command));
+  EXPECT_EQ(pick.x, 10);
+  EXPECT_EQ(pick.y, 20);
+  EXPECT_FALSE(pick.add);
+  const auto& add = std::get<PickAction>(std::get<ViewerAction>(steps[1].command));
+  EXPECT_EQ(add.x, 3.5);
+  EXPECT_TRUE(add.add);
+  EXPECT_TRUE(std::holds_alternative<ClearSelectionAction>(std::get<ViewerAction>(steps[2].command)));
+  EXPECT_EQ(std::get<ExportSelectionAction>(std::get<ViewerAction>(steps[3].command)).path, "out.tck");
+  const auto& expect = std::get<ExpectSelectedAction>(std::get<ViewerAction>(steps[4].command));
+  EXPECT_EQ(expect.count, 2u);
+  EXPECT_EQ(expect.where, "s.txt:6");  // a failed expectation names its line
+}
+
+TEST(ViewerScript, malformedPickingLinesNameTheFileAndLine) {
+  for (const std::string bad :
+       {"pick 1", "pick a 2", "pick -1 2", "pick 1 70000", "pick 1 2 toggle", "pick 1 2 add more", "clear-selection now",
+        "export-selection", "export-selection out.png", "expect-selected", "expect-selected -1", "expect-selected 1.5"}) {
+    SCOPED_TRACE(bad);
+    try {
+      parseScript("wait 1\n" + bad + "\n", "session.txt");
+      ADD_FAILURE() << "no error";
+    } catch (const Error& e) {
+      const std::string message = e.what();
+      EXPECT_EQ(message.rfind("session.txt:2: ", 0), 0u) << message;
+      EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    }
+  }
 }
 
 TEST(ViewerScript, runnerHoldsEachWaitForItsFrames) {
@@ -172,6 +217,47 @@ TEST(ViewerInput, imguiGetsTheMouseFirst) {
   wheel.type = InputEvent::Type::Scroll;
   wheel.y = 1;
   EXPECT_TRUE(m.map(wheel, true, false).empty());
+}
+
+InputEvent click(bool pressed, bool control) {
+  InputEvent e = button(InputEvent::kLeft, pressed);
+  e.control = control;
+  return e;
+}
+
+TEST(ViewerInput, clickPicksAtThePressAndCtrlClickAdds) {
+  InputMapper m;
+  m.map(cursor(50, 60), false, false);
+  EXPECT_TRUE(m.map(click(true, false), false, false).empty());
+  m.map(cursor(52, 61), false, false);  // within the slop: still a click (the orbit follows)
+  auto a = m.map(click(false, false), false, false);
+  ASSERT_EQ(a.size(), 1u);
+  const auto& pick = std::get<PickAction>(a[0]);
+  EXPECT_EQ(pick.x, 50);  // where it was pressed
+  EXPECT_EQ(pick.y, 60);
+  EXPECT_FALSE(pick.add);
+
+  m.map(click(true, /*control=*/true), false, false);
+  a = m.map(click(false, true), false, false);
+  ASSERT_EQ(a.size(), 1u);
+  EXPECT_TRUE(std::get<PickAction>(a[0]).add);
+}
+
+TEST(ViewerInput, dragsShiftClicksAndPanelClicksDoNotPick) {
+  InputMapper m;
+  m.map(cursor(50, 60), false, false);
+  m.map(click(true, false), false, false);
+  m.map(cursor(54, 60), false, false);  // 4 px: a drag
+  m.map(cursor(50, 60), false, false);  // back where it started: still a drag
+  for (const auto& action : m.map(click(false, false), false, false))
+    EXPECT_FALSE(std::holds_alternative<PickAction>(action));
+
+  m.map(button(InputEvent::kLeft, true, /*shift=*/true), false, false);  // pan
+  EXPECT_TRUE(m.map(button(InputEvent::kLeft, false, true), false, false).empty());
+  m.map(click(true, false), /*want_mouse=*/true, false);  // on a panel
+  EXPECT_TRUE(m.map(click(false, false), true, false).empty());
+  m.map(button(InputEvent::kRight, true), false, false);
+  EXPECT_TRUE(m.map(button(InputEvent::kRight, false), false, false).empty());
 }
 
 TEST(ViewerInput, keysSelectStandardViewsResetAndScreenshot) {
@@ -371,6 +457,249 @@ TEST_F(GpuViewer, badOptionsAreOneLineErrors) {
     EXPECT_EQ(r.exit_code, 2) << r.output;
     EXPECT_EQ(lineCount(r.output), 1) << r.output;
   }
+}
+
+
+// --- picking and the selection (Vulkan) -------------------------------------
+
+bool covered(const Png& png, uint32_t x, uint32_t y) {
+  const uint8_t* p = png.at(x, y);
+  return std::max({p[0], p[1], p[2]}) > 40;
+}
+
+// The highlight colour (RenderSettings' default 1, 0.8, 0.1) under the
+// lighting: any brightness, that chromaticity.
+bool highlightColoured(const Png& png, uint32_t x, uint32_t y) {
+  const uint8_t* p = png.at(x, y);
+  const double r = p[0], g = p[1], b = p[2];
+  return r > 60 && std::abs(g / r - 0.8) < 0.08 && b / r < 0.2;
+}
+
+// Points of streamline `s` of `t` equal those of streamline `u` of `other`.
+bool sameStreamline(const Tractogram& t, size_t s, const Tractogram& other, size_t u) {
+  if (t.pointsIn(s) != other.pointsIn(u)) return false;
+  return std::equal(t.positions.begin() + std::ptrdiff_t(3 * t.offsets[s]),
+                    t.positions.begin() + std::ptrdiff_t(3 * t.offsets[s + 1]),
+                    other.positions.begin() + std::ptrdiff_t(3 * other.offsets[u]));
+}
+
+// The phantom fibers equal to streamline `s` of `t` (bit for bit).
+std::vector<size_t> matches(const Tractogram& phantom, const Tractogram& t, size_t s) {
+  std::vector<size_t> found;
+  for (size_t u = 0; u < phantom.streamlineCount(); ++u)
+    if (sameStreamline(t, s, phantom, u)) found.push_back(u);
+  return found;
+}
+
+TEST_F(GpuViewer, scriptedPicksSelectHighlightAndExportTheFiberUnderThePixel) {
+  // A small phantom compressed to a .fbl: the viewer opens it as is, and its
+  // decode (what `fibscope decompress` gives) is the reference.
+  const std::string fbl = dir_.file("p.fbl");
+  CompressOptions options;
+  options.terminal_progress = false;
+  options.threads = 1;
+  compressTractogram(
+      [] {
+        PhantomOptions p;
+        p.streamlines = 300;
+        p.seed = 3;
+        p.threads = 1;
+        return openPhantom(p);
+      },
+      fbl, options);
+  const Tractogram phantom = readAllStreamlines(*openFbl(fbl));
+
+  // The scene alone at the window's size and camera: which pixels are drawn.
+  const std::string script1 = dir_.file("look.txt"), scene_png = dir_.file("scene.png");
+  test::writeBytes(script1, "wait 2\nscreenshot " + scene_png + " 320x200\nquit\n");
+  auto r = runViewer("--offscreen --size 320x200 --script " + script1 + " " + fbl);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Png scene = readOurPng(scene_png);
+  ASSERT_EQ(scene.width, 320u);
+  // A: the covered pixel (whole 3x3 block covered) nearest the centre; B:
+  // the such pixel farthest from A (another fiber there); C: a pixel with
+  // nothing drawn within 3 px.
+  std::optional<std::pair<uint32_t, uint32_t>> a, b, c;
+  auto block = [&](uint32_t x, uint32_t y, int radius, bool want) {
+    for (int dy = -radius; dy <= radius; ++dy)
+      for (int dx = -radius; dx <= radius; ++dx)
+        if (covered(scene, uint32_t(int(x) + dx), uint32_t(int(y) + dy)) != want) return false;
+    return true;
+  };
+  auto dist2 = [](uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1) {
+    return (double(x0) - x1) * (double(x0) - x1) + (double(y0) - y1) * (double(y0) - y1);
+  };
+  for (uint32_t y = 3; y + 3 < scene.height; ++y)
+    for (uint32_t x = 3; x + 3 < scene.width; ++x) {
+      if (block(x, y, 1, true) && (!a || dist2(x, y, 160, 100) < dist2(a->first, a->second, 160, 100))) a = {x, y};
+      if (!c && block(x, y, 3, false)) c = {x, y};
+    }
+  ASSERT_TRUE(a && c) << "no covered or no empty pixel in the scene";
+  for (uint32_t y = 3; y + 3 < scene.height; ++y)
+    for (uint32_t x = 3; x + 3 < scene.width; ++x)
+      if (block(x, y, 1, true) &&
+          (!b || dist2(x, y, a->first, a->second) > dist2(b->first, b->second, a->first, a->second)))
+        b = {x, y};
+  ASSERT_TRUE(b);
+  auto at = [](const std::pair<uint32_t, uint32_t>& p) {
+    return std::to_string(p.first) + " " + std::to_string(p.second);
+  };
+
+  const std::string script2 = dir_.file("pick.txt"), sel_png = dir_.file("sel.png");
+  const std::string one_tck = dir_.file("one.tck"), two_tck = dir_.file("two.tck");
+  test::writeBytes(script2,
+                   "wait 2\n"
+                   "pick " + at(*a) + "\n"
+                   "expect-selected 1\n"
+                   "export-selection " + one_tck + "\n"
+                   "screenshot " + sel_png + " 320x200\n"
+                   "wait 1\n"
+                   "pick " + at(*c) + "\n"  // the background clears the selection
+                   "expect-selected 0\n"
+                   "pick " + at(*a) + "\n"
+                   "pick " + at(*b) + " add\n"
+                   "expect-selected 2\n"
+                   "export-selection " + two_tck + "\n"
+                   "pick " + at(*a) + " add\n"  // ctrl-click on a selected fiber removes it
+                   "expect-selected 1\n"
+                   "clear-selection\n"
+                   "expect-selected 0\n"
+                   "wait 1\n"
+                   "quit\n");
+  r = runViewer("--offscreen --size 320x200 --script " + script2 + " " + fbl);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+
+  const Tractogram one = readAllStreamlines(*openTractogram(one_tck));
+  ASSERT_EQ(one.streamlineCount(), 1u);
+  const std::vector<size_t> fiber_a = matches(phantom, one, 0);
+  ASSERT_EQ(fiber_a.size(), 1u) << "the exported streamline is not exactly one fiber of the phantom";
+  const Tractogram two = readAllStreamlines(*openTractogram(two_tck));
+  ASSERT_EQ(two.streamlineCount(), 2u);
+  EXPECT_TRUE(sameStreamline(two, 0, one, 0));  // in selection order: A first
+  const std::vector<size_t> fiber_b = matches(phantom, two, 1);
+  ASSERT_EQ(fiber_b.size(), 1u);
+  EXPECT_NE(fiber_b[0], fiber_a[0]);
+
+  // The selected fiber takes the highlight colour where it was picked.
+  const Png selected = readOurPng(sel_png);
+  ASSERT_EQ(selected.width, 320u);
+  EXPECT_TRUE(highlightColoured(selected, a->first, a->second));
+  size_t highlighted = 0;
+  for (uint32_t y = 0; y < selected.height; ++y)
+    for (uint32_t x = 0; x < selected.width; ++x) highlighted += highlightColoured(selected, x, y);
+  EXPECT_GT(highlighted, 10u);
+}
+
+TEST_F(GpuViewer, failedSelectionExpectationIsAOneLineErrorNamingTheScriptLine) {
+  const std::string script = dir_.file("expect.txt");
+  test::writeBytes(script, "wait 1\npick 0 0\nexpect-selected 3\nquit\n");
+  const auto r = runViewer("--offscreen --size 64x48 --script " + script);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find(script + ":3: expect-selected 3: 0 fibers are selected"), std::string::npos) << r.output;
+}
+
+// --- loading on the worker (model_loader.h) ---------------------------------
+
+TEST(ViewerScript, openAndWaitLoadedHoldUntilTheLoaderIsIdle) {
+  ScriptRunner runner(parseScript("open a.tck\nwait-loaded\nview axial\nquit\n", "s"));
+  const auto first = runner.nextFrame(/*loading=*/false);  // open is applied; the loader starts
+  ASSERT_EQ(first.size(), 1u);
+  EXPECT_EQ(std::get<OpenAction>(first[0]).path, "a.tck");
+  EXPECT_TRUE(runner.nextFrame(true).empty());
+  EXPECT_TRUE(runner.nextFrame(true).empty());
+  EXPECT_FALSE(runner.finished());
+  EXPECT_EQ(runner.nextFrame(false).size(), 2u);  // view, quit
+  EXPECT_TRUE(runner.finished());
+  EXPECT_THROW(parseScript("open\n", "s"), Error);
+  EXPECT_THROW(parseScript("wait-loaded 3\n", "s"), Error);
+}
+
+TEST(ViewerRecentFiles, newestFirstWithoutDuplicatesAtMostTen) {
+  std::vector<std::string> list;
+  for (int i = 0; i < 12; ++i) list = addRecentFile(std::move(list), "/data/t" + std::to_string(i) + ".tck");
+  list = addRecentFile(std::move(list), "/data/t5.tck");
+  ASSERT_EQ(list.size(), kMaxRecentFiles);
+  EXPECT_EQ(list[0], "/data/t5.tck");
+  EXPECT_EQ(list[1], "/data/t11.tck");
+  EXPECT_EQ(std::count(list.begin(), list.end(), "/data/t5.tck"), 1);
+  EXPECT_EQ(addRecentFile(list, "").size(), kMaxRecentFiles);  // the phantom is not a file
+  const auto relative = addRecentFile({}, "rel/x.tck");
+  ASSERT_EQ(relative.size(), 1u);
+  EXPECT_EQ(relative[0].front(), '/');
+}
+
+TEST(ViewerRecentFiles, savedListReadsBackAndMissingOrDamagedFilesAreHandled) {
+  test::TempDir dir;
+  const std::string a = dir.file("a.tck"), b = dir.file("b.tck"), json = dir.file("cache/recent_files.json");
+  test::writeBytes(a, "x");
+  test::writeBytes(b, "x");
+  ASSERT_EQ(saveRecentFiles(json, {b, a, dir.file("gone.tck")}), "");
+  EXPECT_EQ(loadRecentFiles(json), (std::vector<std::string>{b, a}));  // the missing one is dropped
+  EXPECT_EQ(loadRecentFiles(json, /*drop_missing=*/false).size(), 3u);
+  test::writeBytes(json, "{\"files\": [\"" + a + "\", 3, null");  // truncated
+  EXPECT_TRUE(loadRecentFiles(json).empty());
+  test::writeBytes(json, "{\"files\": [\"" + a + "\", 3]}");  // not a string: skipped
+  EXPECT_EQ(loadRecentFiles(json), std::vector<std::string>{a});
+  EXPECT_TRUE(loadRecentFiles(dir.file("none.json")).empty());
+}
+
+// A .tck whose header points past its end.
+void writeMalformedTck(const std::string& path) {
+  test::writeBytes(path, "mrtrix tracks\ncount: 5\ndatatype: Float32LE\nfile: . 200\nEND\n");
+}
+
+TEST_F(GpuViewer, scriptOpenOfAMalformedFileShowsTheErrorAndKeepsTheModel) {
+  const std::string bad = dir_.file("bad.tck"), script = dir_.file("s.txt"), scene = dir_.file("scene.png");
+  writeMalformedTck(bad);
+  test::writeBytes(script, "open " + bad + "\nwait-loaded\nwait 2\nscreenshot " + scene + " 96x64\nwait 1\nquit\n");
+  const auto r = runViewer("--offscreen --size 320x200 --script " + script);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("fibscope view: " + bad + ": "), std::string::npos) << r.output;
+  const Png png = readOurPng(scene);
+  ASSERT_EQ(png.width, 96u);
+  EXPECT_GT(coverage(png, 0, 0, 96, 64), 0.05);  // the phantom is still drawn
+}
+
+TEST_F(GpuViewer, commandLineFileThatCannotBeReadEndsTheRunWithOneLine) {
+  const std::string bad = dir_.file("bad.tck");
+  writeMalformedTck(bad);
+  const auto r = runViewer("--offscreen --size 64x64 --frames 2 " + bad);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_EQ(lineCount(r.output), 1) << r.output;
+  EXPECT_NE(r.output.find(bad), std::string::npos) << r.output;
+}
+
+TEST_F(GpuViewer, secondOpenOfTheSameFileComesFromTheCache) {
+  const std::string tck = dir_.file("t.tck"), cache = dir_.file("cache");
+  ASSERT_EQ(test::runCommand(std::string(FIBSCOPE_EXE) + " phantom -n 200 " + tck).exit_code, 0);
+  const std::string png = dir_.file("x.png");
+  const auto first = runViewer("--offscreen --size 320x200 --frames 1 --screenshot " + png + " " + tck, "", cache);
+  ASSERT_EQ(first.exit_code, 0) << first.output;
+  EXPECT_NE(first.output.find("opened t.tck compressed in "), std::string::npos) << first.output;
+  const auto second = runViewer("--offscreen --size 320x200 --frames 1 --screenshot " + png + " " + tck, "", cache);
+  ASSERT_EQ(second.exit_code, 0) << second.output;
+  EXPECT_NE(second.output.find("opened t.tck from cache in "), std::string::npos) << second.output;
+  // --frames counts once the file is in: the screenshot shows it.
+  expectSceneAndPanels(readOurPng(png));
+  // The recent files list next to the cache names it.
+  EXPECT_EQ(loadRecentFiles(cache + "/recent_files.json"), std::vector<std::string>{tck});
+}
+
+TEST_F(GpuViewer, scriptLoadRunsOnTheWorkerWhileFramesGoOn) {
+  const std::string tck = dir_.file("big.tck"), script = dir_.file("s.txt"), scene = dir_.file("scene.png");
+  ASSERT_EQ(test::runCommand(std::string(FIBSCOPE_EXE) + " phantom -n 3000 " + tck).exit_code, 0);
+  test::writeBytes(script, "open " + tck + "\nwait-loaded\nscreenshot " + scene + " 96x64\nwait 1\nquit\n");
+  const auto r = runViewer("--offscreen --size 160x100 --script " + script);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const size_t at = r.output.find("opened big.tck compressed in ");
+  ASSERT_NE(at, std::string::npos) << r.output;
+  const size_t comma = r.output.find(" in all, ", at);
+  ASSERT_NE(comma, std::string::npos) << r.output;
+  const int frames = std::atoi(r.output.c_str() + comma + 9);
+  EXPECT_GE(frames, 2) << "frames drawn while the file was compressed: " << r.output;
+  const Png png = readOurPng(scene);
+  ASSERT_EQ(png.width, 96u);
+  EXPECT_GT(coverage(png, 0, 0, 96, 64), 0.05);
 }
 
 }  // namespace

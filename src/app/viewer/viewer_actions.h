@@ -44,15 +44,37 @@ struct OpenAction {  // a tractogram file to add to the model list (empty: the b
 struct CloseModelAction {  // removes a model from the list (index into ViewerState::models)
   int model = -1;
 };
+// Picking (left click / ctrl + left click, or a script's `pick`): the fiber
+// drawn at window pixel (x, y) of the last frame (y down). A plain pick
+// makes the selection that fiber (the background clears it); `add` toggles
+// the fiber in the selection.
+struct PickAction {
+  double x = 0, y = 0;
+  bool add = false;
+};
+struct ClearSelectionAction {};
+struct ExportSelectionAction {  // the selected fibers to a .tck
+  std::string path;
+};
+// A script's check: the run fails (Error "`where`: ...") unless exactly
+// `count` fibers are selected.
+struct ExpectSelectedAction {
+  uint64_t count = 0;
+  std::string where;  // "SCRIPT:LINE"
+};
 struct QuitAction {};
 
 using ViewerAction = std::variant<OrbitAction, PanAction, DollyAction, ViewAction, FovAction, SetAction,
-                                  ScreenshotAction, OpenAction, CloseModelAction, QuitAction>;
+                                  ScreenshotAction, OpenAction, CloseModelAction, PickAction, ClearSelectionAction,
+                                  ExportSelectionAction, ExpectSelectedAction, QuitAction>;
 
 // Sets one RenderSettings field from text, as `set KEY VALUE` in a script:
 //   pipeline compute|lines|raw-compute, culling none|frustum|two-phase,
-//   color orientation|solid|fiber, lighting illuminated|none,
-//   width 1..4 (px), ssao on|off, background R,G,B (each in [0, 1]).
+//   color orientation|solid|fiber|scalar|normal, colormap viridis|magma|
+//   grayscale|coolwarm, scalar-range MIN,MAX, lighting illuminated|none,
+//   width 1..4 (px), ssao on|off, ssao-radius 1..64 (px), ssao-strength
+//   0..1, ao-scales 1..4, fxaa on|off, background R,G,B and highlight R,G,B
+//   (each in [0, 1]), dim 0..1 (unselected fibers towards the background).
 // Throws Error (one line) naming the key and what was expected; leaves
 // `settings` unchanged then. Safe on untrusted text.
 void applySetting(RenderSettings& settings, std::string_view key, std::string_view value);

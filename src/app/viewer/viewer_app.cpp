@@ -20,6 +20,7 @@
 #include "app/viewer/recent_files.h"
 #include "app/viewer/viewer_input.h"
 #include "app/viewer/viewer_script.h"
+#include "app/viewer/viewer_selection.h"
 #include "app/viewer/viewer_state.h"
 #include "app/viewer/viewer_ui.h"
 #include "app/viewer/viewer_window.h"
@@ -31,6 +32,7 @@
 #include "phantom/phantom.h"
 #include "render/gpu_dataset.h"
 #include "render/gpu_frame_renderer.h"
+#include "render/gpu_pick.h"
 #include "render/gpu_raw_tractogram.h"
 #include "render/orbit_controller.h"
 #include "render/reference_raster.h"
@@ -136,6 +138,10 @@ class ViewerApp {
   bool drawFrame(uint32_t width, uint32_t height, double dt);
   void recordFrame(VkCommandBuffer cmd, uint32_t width, uint32_t height, const Camera& camera);
   void takeScreenshot(const ScreenshotAction& shot);
+  // Picking and the selection (viewer_selection.h), between frames.
+  void syncSelection();
+  void pickAt(const PickAction& pick);
+  GpuScene withSelection(GpuScene scene) const;
   std::string freshScreenshotPath();
 
   ViewerOptions options_;
@@ -150,6 +156,10 @@ class ViewerApp {
   std::unique_ptr<FrameRenderer> shot_renderer_;  // scene-only screenshots at a chosen size
   std::vector<std::unique_ptr<ViewerModel>> scenes_;  // index-aligned with state_.models
   int framed_model_ = -1;  // the model the camera was last framed on
+  std::unique_ptr<ViewerSelection> selection_;
+  // The dataset the G-buffer shows (the last frame drawn; null after a
+  // resize or a frame without a model): picks read it.
+  const GpuDataset* drawn_dataset_ = nullptr;
   // Loading: one worker (model_loader.h); the jobs named on the command
   // line not finished yet (frames and the script count once they are).
   std::unique_ptr<ModelLoader> loader_;
@@ -218,6 +228,7 @@ void ViewerApp::createFrameObjects() {
   presentation_ = createPresentation(*context_, width, height);
   imgui_ = std::make_unique<ImGuiLayer>(*context_, presentation_.render_pass, window_ ? window_->handle() : nullptr);
   renderer_ = std::make_unique<FrameRenderer>(*context_, width, height);
+  selection_ = std::make_unique<ViewerSelection>(*context_);
 
   VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
   alloc.commandPool = context_->commandPool();
@@ -250,6 +261,7 @@ void ViewerApp::release() {
   imgui_.reset();
   shot_renderer_.reset();
   renderer_.reset();
+  selection_.reset();
   scenes_.clear();
   destroyPresentation(*context_, presentation_);
   if (swapchain_.swapchain != VK_NULL_HANDLE) gpu::destroySwapchain(*context_, swapchain_);
@@ -477,6 +489,24 @@ void ViewerApp::apply(const ViewerAction& action) {
           openModel(a.path);  // on the worker: framed when it is added
         } else if constexpr (std::is_same_v<A, CloseModelAction>) {
           closeModel(a.model);
+        } else if constexpr (std::is_same_v<A, PickAction>) {
+          pickAt(a);
+        } else if constexpr (std::is_same_v<A, ClearSelectionAction>) {
+          selection_->clear();
+          syncSelection();
+        } else if constexpr (std::is_same_v<A, ExportSelectionAction>) {
+          try {
+            syncSelection();  // a model closed meanwhile takes its selection with it
+            selection_->exportTck(a.path);
+            state_.status = "exported " + std::to_string(selection_->size()) + " fibers to " + a.path;
+          } catch (const Error& e) {
+            state_.status = e.what();
+            std::fprintf(stderr, "fibscope view: %s\n", e.what());
+          }
+        } else if constexpr (std::is_same_v<A, ExpectSelectedAction>) {
+          if (selection_->size() != a.count)
+            throw Error(a.where + ": expect-selected " + std::to_string(a.count) + ": " +
+                        std::to_string(selection_->size()) + " fibers are selected");
         } else if constexpr (std::is_same_v<A, QuitAction>) {
           quit_ = true;
         }
@@ -507,7 +537,8 @@ void ViewerApp::takeScreenshot(const ScreenshotAction& shot) {
     if (!shot_renderer_) shot_renderer_ = std::make_unique<FrameRenderer>(*context_, shot.width, shot.height);
     shot_renderer_->resize(shot.width, shot.height);
     const Camera camera = controller_.camera(shot.width, shot.height);
-    shot_renderer_->render(camera, drawSettings(*scene), scene->gpuScene());
+    syncSelection();
+    shot_renderer_->render(camera, drawSettings(*scene), withSelection(scene->gpuScene()));
     writePngRgba(path, shot.width, shot.height, downloadColor(*context_, shot_renderer_->targets()));
     controller_.setViewport(presentation_.width, presentation_.height);  // camera() noted the shot's size
     state_.status = "saved " + path;
@@ -515,6 +546,49 @@ void ViewerApp::takeScreenshot(const ScreenshotAction& shot) {
     state_.status = e.what();
     std::fprintf(stderr, "fibscope view: %s\n", e.what());
   }
+}
+
+void ViewerApp::syncSelection() {
+  // The selection belongs to the active model, shown or hidden.
+  SelectionSource source;
+  const int m = state_.active_model;
+  if (m >= 0 && m < int(scenes_.size()) && scenes_[size_t(m)]) {
+    const ViewerModel& model = *scenes_[size_t(m)];
+    source.dataset = &model.fiblets;
+    source.fbl = &model.data->fbl;
+    source.path = model.data->source_path;
+  }
+  try {
+    finishFrame();  // uploads wait for the queue; the frame in flight reads the bits
+    selection_->sync(source, state_.selection);
+  } catch (const Error& e) {
+    state_.status = e.what();
+  }
+}
+
+void ViewerApp::pickAt(const PickAction& pick) {
+  try {
+    finishFrame();
+    PickResult result;  // no hit
+    // The G-buffer holds the last frame drawn: it answers for that model only.
+    if (drawn_dataset_ && drawn_dataset_ == selection_->dataset() && pick.x < presentation_.width &&
+        pick.y < presentation_.height)
+      result = pickFiber(*context_, renderer_->targets(), uint32_t(pick.x), uint32_t(pick.y));
+    selection_->pick(result, pick.add);
+    syncSelection();
+    const size_t n = selection_->size();
+    state_.status = (result.hit ? "fiber " + std::to_string(result.fiber) + ": " : std::string("no fiber there: ")) +
+                    std::to_string(n) + (n == 1 ? " fiber" : " fibers") + " selected";
+  } catch (const Error& e) {
+    state_.status = e.what();
+    std::fprintf(stderr, "fibscope view: %s\n", e.what());
+  }
+}
+
+GpuScene ViewerApp::withSelection(GpuScene scene) const {
+  // The bits are sized for the selection's dataset: never for another one.
+  if (scene.fiblets && scene.fiblets == selection_->dataset()) scene.selection_bits = selection_->bits();
+  return scene;
 }
 
 void ViewerApp::finishFrame() {
@@ -531,6 +605,7 @@ void ViewerApp::resizeTo(uint32_t width, uint32_t height) {
   finishFrame();
   vkDeviceWaitIdle(context_->device());
   renderer_->resize(width, height);
+  drawn_dataset_ = nullptr;  // the G-buffer is new: nothing to pick until a frame is drawn
   resizePresentation(*context_, presentation_, width, height);
   if (window_) {
     gpu::recreateSwapchain(*context_, swapchain_, width, height);
@@ -540,8 +615,10 @@ void ViewerApp::resizeTo(uint32_t width, uint32_t height) {
 
 void ViewerApp::recordFrame(VkCommandBuffer cmd, uint32_t width, uint32_t height, const Camera& camera) {
   const ViewerModel* scene = activeScene();
+  drawn_dataset_ = nullptr;
   if (scene) {
-    renderer_->record(cmd, camera, drawSettings(*scene), scene->gpuScene());
+    renderer_->record(cmd, camera, drawSettings(*scene), withSelection(scene->gpuScene()));
+    drawn_dataset_ = &scene->fiblets;
   } else {
     // Nothing to draw: the background alone (RGBA8, R in the low byte).
     auto byte = [](float v) { return uint32_t(std::clamp(v, 0.0f, 1.0f) * 255.0f + 0.5f); };
@@ -581,6 +658,7 @@ bool ViewerApp::drawFrame(uint32_t width, uint32_t height, double dt) {
   ensureRawFor(state_.active_model);
   if (state_.fov_deg != controller_.fovY()) controller_.setFovY(state_.fov_deg);
   const Camera camera = controller_.camera(width, height);
+  syncSelection();  // the highlight's bits for this frame (nothing in flight now)
 
   VK_CHECK(vkResetCommandBuffer(cmd_, 0));
   VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};

@@ -2,6 +2,8 @@
 
 #include <GLFW/glfw3.h>
 
+#include <cmath>
+
 namespace fibscope {
 
 std::vector<ViewerAction> InputMapper::map(const InputEvent& e, bool want_mouse, bool want_keyboard) {
@@ -9,6 +11,8 @@ std::vector<ViewerAction> InputMapper::map(const InputEvent& e, bool want_mouse,
   switch (e.type) {
     case InputEvent::Type::CursorMoved: {
       const double dx = e.x - last_x_, dy = e.y - last_y_;
+      if (click_armed_ && (std::abs(e.x - press_x_) > kClickSlopPx || std::abs(e.y - press_y_) > kClickSlopPx))
+        click_armed_ = false;
       if (have_cursor_ && (dx != 0 || dy != 0)) {
         if (drag_ == Drag::Orbit) actions.push_back(OrbitAction{dx, dy});
         if (drag_ == Drag::Pan) actions.push_back(PanAction{dx, dy});
@@ -20,12 +24,23 @@ std::vector<ViewerAction> InputMapper::map(const InputEvent& e, bool want_mouse,
     }
     case InputEvent::Type::MouseButton:
       if (!e.pressed) {
+        if (e.button == InputEvent::kLeft && click_armed_) {
+          actions.push_back(PickAction{press_x_, press_y_, click_add_});
+          click_armed_ = false;
+        }
         if (e.button == drag_button_) {
           drag_ = Drag::None;
           drag_button_ = -1;
         }
       } else if (!want_mouse && drag_ == Drag::None) {
-        if (e.button == InputEvent::kLeft) drag_ = e.shift ? Drag::Pan : Drag::Orbit;
+        if (e.button == InputEvent::kLeft) {
+          drag_ = e.shift ? Drag::Pan : Drag::Orbit;
+          // The click picks at the press (the cursor may creep before the release).
+          click_armed_ = !e.shift && have_cursor_;
+          click_add_ = e.control;
+          press_x_ = last_x_;
+          press_y_ = last_y_;
+        }
         if (e.button == InputEvent::kMiddle) drag_ = Drag::Pan;
         if (drag_ != Drag::None) drag_button_ = e.button;
       }

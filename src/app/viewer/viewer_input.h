@@ -1,7 +1,9 @@
 // Mouse and keys to viewer actions, as mrview users expect: left drag
 // orbits, middle drag or shift + left drag pans, the wheel dollies; keys
 // 1/2/3 (or S/C/A) the sagittal, coronal and axial views, R resets,
-// F12 (or P) takes a screenshot; dropped files are opened. ImGui gets the
+// F12 (or P) takes a screenshot; dropped files are opened. A left click
+// (press and release within kClickSlopPx) picks the fiber under it,
+// ctrl + click adds it to (or removes it from) the selection. ImGui gets the
 // mouse and keyboard first when it wants them (a drag that starts on a
 // panel stays with the panel).
 #pragma once
@@ -32,12 +34,20 @@ class InputMapper {
   // io.WantCaptureMouse / io.WantCaptureKeyboard for this frame.
   std::vector<ViewerAction> map(const InputEvent& event, bool want_mouse, bool want_keyboard);
 
+  // A left press and release farther apart than this (window pixels, either
+  // axis) is a drag, not a click.
+  static constexpr double kClickSlopPx = 3.0;
+
  private:
   enum class Drag : uint8_t { None, Orbit, Pan };
   Drag drag_ = Drag::None;
   int drag_button_ = -1;
   bool have_cursor_ = false;
   double last_x_ = 0, last_y_ = 0;
+  // The left press that may become a click: where, with ctrl, and whether
+  // the cursor has left the slop since.
+  bool click_armed_ = false, click_add_ = false;
+  double press_x_ = 0, press_y_ = 0;
 };
 
 }  // namespace fibscope

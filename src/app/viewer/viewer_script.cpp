@@ -89,12 +89,39 @@ std::variant<ViewerAction, WaitFrames, WaitLoaded> parseCommand(const std::vecto
     expectArguments(w, 0, 0, "wait-loaded");
     return WaitLoaded{};
   }
+  if (name == "pick") {
+    expectArguments(w, 2, 3, "pick X Y [add]");
+    const double x = number(w[1], "X"), y = number(w[2], "Y");
+    if (!(x >= 0 && x < 65536 && y >= 0 && y < 65536))
+      throw Error("pick: expected window pixels from 0 to 65535, got " + std::string(w[1]) + " " + std::string(w[2]));
+    if (w.size() == 4 && w[3] != "add") throw Error("pick: expected 'add' or nothing after X Y, got '" + std::string(w[3]) + "'");
+    return ViewerAction{PickAction{x, y, w.size() == 4}};
+  }
+  if (name == "clear-selection") {
+    expectArguments(w, 0, 0, "clear-selection");
+    return ViewerAction{ClearSelectionAction{}};
+  }
+  if (name == "export-selection") {
+    expectArguments(w, 1, 1, "export-selection OUT.tck");
+    const std::string path(w[1]);
+    if (path.size() < 5 || path.substr(path.size() - 4) != ".tck")
+      throw Error("export-selection: the output must be a .tck file, got '" + path + "'");
+    return ViewerAction{ExportSelectionAction{path}};
+  }
+  if (name == "expect-selected") {
+    expectArguments(w, 1, 1, "expect-selected N");
+    const double n = number(w[1], "N");
+    if (!(n >= 0 && n <= 4294967295.0) || n != std::floor(n))
+      throw Error("expect-selected: expected a fiber count, got " + std::string(w[1]));
+    return ViewerAction{ExpectSelectedAction{uint64_t(n), {}}};
+  }
   if (name == "quit") {
     expectArguments(w, 0, 0, "quit");
     return ViewerAction{QuitAction{}};
   }
   throw Error("unknown command '" + std::string(name) +
-              "' (expected orbit, pan, dolly, view, fov, set, wait, wait-loaded, open, screenshot or quit)");
+              "' (expected orbit, pan, dolly, view, fov, set, wait, wait-loaded, open, screenshot, pick, "
+              "clear-selection, export-selection, expect-selected or quit)");
 }
 
 }  // namespace
@@ -114,6 +141,10 @@ std::vector<ScriptStep> parseScript(std::string_view text, const std::string& pa
     if (words.empty()) continue;
     try {
       steps.push_back({line_number, parseCommand(words)});
+      // A failed expectation names the script line it came from.
+      if (auto* action = std::get_if<ViewerAction>(&steps.back().command))
+        if (auto* expect = std::get_if<ExpectSelectedAction>(action))
+          expect->where = path + ":" + std::to_string(line_number);
     } catch (const Error& e) {
       throw Error(path + ":" + std::to_string(line_number) + ": " + e.what());
     }

@@ -10,6 +10,10 @@
 //   screenshot OUT.png [WxH]    (WxH: the scene alone at that size)
 //   open PATH                   (loads on the worker; frames go on meanwhile)
 //   wait-loaded                 (holds until no load is queued or running)
+//   pick X Y [add]              (window pixels of the last frame; add: ctrl-click)
+//   clear-selection
+//   export-selection OUT.tck    (the selected fibers of the active model)
+//   expect-selected N           (the run fails naming the line unless N are selected)
 //   quit
 #pragma once
 

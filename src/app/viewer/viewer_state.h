@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -55,9 +56,25 @@ struct FrameRecord {
   FrameStats gpu;       // passes, GPU time, fiblets drawn
 };
 
+// The active model's fiber selection, for the selection panel
+// (viewer_ui_selection.cpp); the frame loop fills it from its
+// ViewerSelection after each change.
+struct SelectedFiber {
+  uint32_t fiber = 0;              // streamline index in the model
+  std::optional<float> length_mm;  // nullopt: no length in reach
+};
+struct SelectionInfo {
+  std::vector<SelectedFiber> fibers;  // in selection order
+  bool exportable = false;            // the model's .fbl is in reach
+  std::string export_path = "selection.tck";
+};
+
 struct ViewerState {
   RenderSettings settings;
   double fov_deg = 30;
+  // The active model's per-fiber scalar (fiber length, mm) range, for the
+  // scalar colour mode's "fit" button; min > max while unknown.
+  float scalar_data_min = 1, scalar_data_max = 0;
 
   std::vector<ModelInfo> models;
   int active_model = -1;  // index into models, -1: none
@@ -65,6 +82,7 @@ struct ViewerState {
   std::vector<LoadingInfo> loading;  // the running job first; empty when idle
   std::vector<LoadFailure> load_failures;
   std::vector<std::string> recent_files;  // newest first (recent_files.h)
+  SelectionInfo selection;  // of the active model
 
   // Newest last, at most kFrameHistory.
   static constexpr size_t kFrameHistory = 240;
@@ -82,6 +100,7 @@ struct ViewerState {
   bool show_settings = true;
   bool show_performance = true;
   bool show_models = true;
+  bool show_selection = true;
   std::string screenshot_path = "fibscope.png";  // the screenshot button's file
   int screenshot_width = 0, screenshot_height = 0;  // 0: the window as shown
 };

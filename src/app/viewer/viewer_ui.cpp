@@ -152,6 +152,7 @@ std::vector<ViewerAction> drawViewerUi(ViewerState& state) {
       ImGui::MenuItem("Models", nullptr, &state.show_models);
       ImGui::MenuItem("Render settings", nullptr, &state.show_settings);
       ImGui::MenuItem("Performance", nullptr, &state.show_performance);
+      ImGui::MenuItem("Selection", nullptr, &state.show_selection);
       ImGui::EndMenu();
     }
     if (ImGui::MenuItem("Screenshot")) actions.push_back(ScreenshotAction{});
@@ -161,6 +162,7 @@ std::vector<ViewerAction> drawViewerUi(ViewerState& state) {
   drawLoadingOverlay(state);
   if (state.show_settings) settingsPanel(state, actions);
   if (state.show_performance) performanceOverlay(state);
+  if (state.show_selection) drawSelectionPanel(state, actions);
   statusLine(state);
   return actions;
 }

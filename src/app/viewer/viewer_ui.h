@@ -20,4 +20,9 @@ std::vector<ViewerAction> drawViewerUi(ViewerState& state);
 void drawModelsPanel(ViewerState& state, std::vector<ViewerAction>& actions);
 void drawLoadingOverlay(const ViewerState& state);
 
+// viewer_ui_selection.cpp: the selection panel (the selected fibers with
+// index and length, clear, export to .tck, highlight colour and dimming),
+// shown while something is selected.
+void drawSelectionPanel(ViewerState& state, std::vector<ViewerAction>& actions);
+
 }  // namespace fibscope
