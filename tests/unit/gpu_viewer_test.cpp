@@ -126,8 +126,9 @@ TEST(ViewerScript, parsesPickingAndSelectionCommands) {
 
 TEST(ViewerScript, malformedPickingLinesNameTheFileAndLine) {
   for (const std::string bad :
-       {"pick 1", "pick a 2", "pick -1 2", "pick 1 70000", "pick 1 2 toggle", "pick 1 2 add more", "clear-selection now",
-        "export-selection", "export-selection out.png", "expect-selected", "expect-selected -1", "expect-selected 1.5"}) {
+       {"pick 1", "pick a 2", "pick -1 2", "pick 1 70000", "pick 1 2 toggle", "pick 1 2 add more",
+        "clear-selection now", "export-selection", "export-selection out.png", "expect-selected",
+        "expect-selected -1", "expect-selected 1.5"}) {
     SCOPED_TRACE(bad);
     try {
       parseScript("wait 1\n" + bad + "\n", "session.txt");

@@ -94,7 +94,8 @@ std::variant<ViewerAction, WaitFrames, WaitLoaded> parseCommand(const std::vecto
     const double x = number(w[1], "X"), y = number(w[2], "Y");
     if (!(x >= 0 && x < 65536 && y >= 0 && y < 65536))
       throw Error("pick: expected window pixels from 0 to 65535, got " + std::string(w[1]) + " " + std::string(w[2]));
-    if (w.size() == 4 && w[3] != "add") throw Error("pick: expected 'add' or nothing after X Y, got '" + std::string(w[3]) + "'");
+    if (w.size() == 4 && w[3] != "add")
+      throw Error("pick: expected 'add' or nothing after X Y, got '" + std::string(w[3]) + "'");
     return ViewerAction{PickAction{x, y, w.size() == 4}};
   }
   if (name == "clear-selection") {
