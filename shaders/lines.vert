@@ -1,7 +1,9 @@
 // Lines baseline (DESIGN.md section 6; the paper's "basic OpenGL" column):
 // the uncompressed float vertices drawn as line strips, one indirect draw
 // per streamline (firstInstance = the streamline index, firstVertex = 0),
-// vertices pulled through buffer references (no vertex input state).
+// recorded chunk by chunk with the chunk in the push constants, vertices
+// pulled from that chunk's buffer through buffer references (no vertex
+// input state).
 // Writes, flat from the provoking (first) vertex of each segment, what the
 // G-buffer texel needs besides the depth.
 #version 460
@@ -25,13 +27,16 @@ void main() {
   RawOffsetsRef offsets = RawOffsetsRef(t.offsets);
   const uint64_t first = offsets.values[fiber];
   const uint64_t count = offsets.values[fiber + 1u] - first;
-  const vec3 p = rawPoint(t, first + uint64_t(vertex));
+  // The streamline lies wholly in the draw's chunk.
+  const RawChunk c = rawChunk(t, pc.chunk);
+  const uint64_t j = first - c.first_point + uint64_t(vertex);
+  const vec3 p = rawChunkPoint(c, j);
   gl_Position = cameraTransformPoint(CameraRef(pc.camera).camera.view_projection, p);
   // The segment vertex -> vertex + 1; the last vertex of a strip provokes
   // no segment.
   uint tangent = 0u;
   if (uint64_t(vertex) + 1ul < count) {
-    const vec3 d = rawPoint(t, first + uint64_t(vertex) + 1ul) - p;
+    const vec3 d = rawChunkPoint(c, j + 1ul) - p;
     if (dot(d, d) > 0.0) tangent = packTangent(normalize(d));
   }
   out_fiber = fiber;

@@ -1,8 +1,9 @@
 // Resolve for the raw-compute baseline: per pixel, the winning key's
 // payload (the global index of the segment's first point) becomes a
-// G-buffer texel: the fiber by binary search in the streamline offsets, the
-// segment as the point's index within its fiber, the tangent from the
-// segment's two points.
+// G-buffer texel: the chunk by binary search in the chunk table, the fiber
+// by binary search in the streamline offsets of that chunk's streamlines,
+// the segment as the point's index within its fiber, the tangent from the
+// segment's two points (both in the chunk: chunks hold whole streamlines).
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_buffer_reference : require
@@ -28,8 +29,10 @@ void main() {
   if (key != 0xFFFFFFFFFFFFFFFFul) {
     const RawTractogram t = RawTractogramRef(pc.tractogram).t;
     const uint64_t point = visibilityPayload(key);
-    const uint fiber = rawStreamlineOfPoint(t, point);
-    const vec3 d = rawPoint(t, point + 1ul) - rawPoint(t, point);
+    const RawChunk c = rawChunk(t, rawChunkOfPoint(t, point));
+    const uint fiber = rawStreamlineOfPoint(t, c, point);
+    const uint64_t j = point - c.first_point;
+    const vec3 d = rawChunkPoint(c, j + 1ul) - rawChunkPoint(c, j);
     texel.depth = visibilityDepth(key);
     texel.fiber = fiber;
     texel.segment = uint(point - RawOffsetsRef(t.offsets).values[fiber]);

@@ -87,22 +87,29 @@ void recordLines(VkCommandBuffer cmd, const gpu::VulkanContext& context, LinesPa
     push.tractogram = tractogram.blockAddress();
     push.camera = frame.camera.address;
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pass.pipeline.pipeline);
-    vkCmdPushConstants(cmd, pass.pipeline.layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
-                       sizeof(push), &push);
     vkCmdSetLineWidth(cmd, linesDrawnWidth(context, line_width_px));
-    if (tractogram.hostCounts().empty()) {
-      // Every streamline in as few indirect draws as maxDrawIndirectCount
-      // allows (one on every device we know of).
-      const uint32_t per_call = std::max<uint32_t>(context.limits().maxDrawIndirectCount, 1);
-      for (uint32_t first = 0; first < streamlines; first += std::min(per_call, streamlines - first)) {
-        const uint32_t count = std::min(per_call, streamlines - first);
-        vkCmdDrawIndirect(cmd, tractogram.draws().buffer, VkDeviceSize(first) * sizeof(VkDrawIndirectCommand), count,
-                          sizeof(VkDrawIndirectCommand));
+    // Chunk by chunk, the chunk in the push constants (the vertex shader
+    // pulls from its buffer); streamlines in order, so primitive order, and
+    // with it the depth test's ties, is that of one draw over all of them.
+    const uint32_t per_call = std::max<uint32_t>(context.limits().maxDrawIndirectCount, 1);
+    for (uint32_t c = 0; c < tractogram.chunkCount(); ++c) {
+      const shader::RawChunk& chunk = tractogram.chunk(c).entry;
+      if (chunk.point_count < 2) continue;
+      push.chunk = c;
+      vkCmdPushConstants(cmd, pass.pipeline.layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+                         sizeof(push), &push);
+      const uint32_t begin = chunk.first_streamline, end = chunk.first_streamline + chunk.streamline_count;
+      if (tractogram.hostCounts().empty()) {
+        // The chunk's streamlines in as few indirect draws as
+        // maxDrawIndirectCount allows (one on every device we know of).
+        for (uint32_t first = begin; first < end; first += std::min(per_call, end - first))
+          vkCmdDrawIndirect(cmd, tractogram.draws().buffer, VkDeviceSize(first) * sizeof(VkDrawIndirectCommand),
+                            std::min(per_call, end - first), sizeof(VkDrawIndirectCommand));
+      } else {
+        const std::vector<uint32_t>& counts = tractogram.hostCounts();
+        for (uint32_t s = begin; s < end; ++s)
+          if (counts[s] >= 2) vkCmdDraw(cmd, counts[s], 1, 0, s);
       }
-    } else {
-      const std::vector<uint32_t>& counts = tractogram.hostCounts();
-      for (uint32_t s = 0; s < streamlines; ++s)
-        if (counts[s] >= 2) vkCmdDraw(cmd, counts[s], 1, 0, s);
     }
   }
   gpu::endRendering(cmd);

@@ -11,10 +11,11 @@
 // reference's capsule rule, so coverage differs from the compute pipelines
 // by up to about a pixel; tests measure by how much.
 //
-// One vkCmdDrawIndirect covers every streamline (firstInstance = the
-// streamline) where the device has multiDrawIndirect and
-// drawIndirectFirstInstance; otherwise one vkCmdDraw per streamline from
-// the host's counts. Widths above 1 need wideLines; without it, lines are 1
+// One vkCmdDrawIndirect per chunk of points covers its streamlines
+// (firstInstance = the streamline; the chunk, whose buffer the vertex
+// shader pulls from, in the push constants) where the device has
+// multiDrawIndirect and drawIndirectFirstInstance; otherwise one vkCmdDraw
+// per streamline from the host's counts. Widths above 1 need wideLines; without it, lines are 1
 // px wide.
 #pragma once
 

@@ -25,17 +25,22 @@ void destroyRawPasses(const gpu::VulkanContext& context, RawPasses& passes) {
 
 void recordRawRaster(VkCommandBuffer cmd, const gpu::VulkanContext& context, const RawPasses& passes,
                      const GpuRawTractogram& tractogram, const GpuFrameTargets& frame) {
-  // Candidate segments i -> i + 1 for i < points - 1; the shader skips
-  // those that join two streamlines.
-  const uint64_t points = tractogram.pointCount();
-  if (points < 2) return;
-  const uint64_t groups = (points - 1 + shader::kRawRasterGroupSize - 1) / shader::kRawRasterGroupSize;
+  // One dispatch per chunk over its candidate segments j -> j + 1, j <
+  // points - 1; the shader skips those that join two streamlines. The
+  // dispatches only meet in atomic minima on the visibility buffer, so they
+  // need no barriers between them.
   shader::RawRasterPush push{};
   push.tractogram = tractogram.blockAddress();
   push.camera = frame.camera.address;
   push.visibility = frame.visibility.address;
-  const gpu::DispatchGrid grid = gpu::dispatchGrid(context, groups);
-  gpu::recordDispatch(cmd, passes.raster, push, grid.x, grid.y);
+  for (uint32_t c = 0; c < tractogram.chunkCount(); ++c) {
+    const uint64_t points = tractogram.chunk(c).entry.point_count;
+    if (points < 2) continue;
+    const uint64_t groups = (points - 1 + shader::kRawRasterGroupSize - 1) / shader::kRawRasterGroupSize;
+    push.chunk = c;
+    const gpu::DispatchGrid grid = gpu::dispatchGrid(context, groups);
+    gpu::recordDispatch(cmd, passes.raster, push, grid.x, grid.y);
+  }
 }
 
 void recordRawResolve(VkCommandBuffer cmd, const RawPasses& passes, const GpuRawTractogram& tractogram,

@@ -2,7 +2,8 @@
 // point-cloud compute column): shaders/raw_raster.comp rasterises every
 // segment of the uncompressed float vertices into the 64-bit visibility
 // buffer with the pixel rule of the fiblet raster, no culling, and
-// shaders/raw_resolve.comp turns the winning keys into G-buffer texels.
+// shaders/raw_resolve.comp turns the winning keys into G-buffer texels
+// (finding each key's chunk by binary search in the chunk table).
 //
 // Recording functions bind, push and dispatch only; the frame renderer
 // places the barriers and timestamps.
@@ -25,7 +26,8 @@ struct RawPasses {
 RawPasses createRawPasses(const gpu::VulkanContext& context);
 void destroyRawPasses(const gpu::VulkanContext& context, RawPasses& passes);
 
-// Every segment, kRawRasterGroupSize invocations per workgroup on a 2D grid.
+// Every segment: one dispatch per chunk of points, kRawRasterGroupSize
+// invocations per workgroup on a 2D grid.
 void recordRawRaster(VkCommandBuffer cmd, const gpu::VulkanContext& context, const RawPasses& passes,
                      const GpuRawTractogram& tractogram, const GpuFrameTargets& frame);
 void recordRawResolve(VkCommandBuffer cmd, const RawPasses& passes, const GpuRawTractogram& tractogram,

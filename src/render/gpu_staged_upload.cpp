@@ -15,7 +15,7 @@ ChunkSource bytesOf(const void* data) {
 }
 
 void uploadChunked(const gpu::VulkanContext& context, const gpu::Buffer& staging, const gpu::Buffer& destination,
-                   uint64_t bytes, const ChunkSource& source, Progress* progress) {
+                   uint64_t bytes, const ChunkSource& source, Progress* progress, uint64_t destination_offset) {
   for (uint64_t offset = 0; offset < bytes;) {
     const uint64_t chunk = std::min<uint64_t>(staging.size, bytes - offset);
     source(static_cast<uint8_t*>(staging.mapped), offset, chunk);
@@ -26,7 +26,7 @@ void uploadChunked(const gpu::VulkanContext& context, const gpu::Buffer& staging
       VK_CHECK(vkFlushMappedMemoryRanges(context.device(), 1, &range));
     }
     gpu::submitOnce(context, [&](VkCommandBuffer cmd) {
-      const VkBufferCopy copy{0, offset, chunk};
+      const VkBufferCopy copy{0, destination_offset + offset, chunk};
       vkCmdCopyBuffer(cmd, staging.buffer, destination.buffer, 1, &copy);
       // The fence orders the host only: make the copy visible to every
       // later command on the queue (compute, vertex pulling, indirect reads).

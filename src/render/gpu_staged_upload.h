@@ -20,11 +20,12 @@ using ChunkSource = std::function<void(uint8_t* out, uint64_t offset, uint64_t b
 // A ChunkSource copying from `data` (which must outlive the upload).
 ChunkSource bytesOf(const void* data);
 
-// Copies `bytes` bytes produced by `source` to the start of `destination`
-// through `staging` (an Upload buffer), one staging-full at a time, each
-// copy submitted and waited for, and made visible to every later command on
-// the queue. `progress` (optional) counts the bytes.
+// Copies `bytes` bytes produced by `source` to `destination` from byte
+// `destination_offset` on, through `staging` (an Upload buffer), one
+// staging-full at a time, each copy submitted and waited for, and made
+// visible to every later command on the queue. `progress` (optional) counts
+// the bytes. The source's offsets count from the start of its own bytes.
 void uploadChunked(const gpu::VulkanContext& context, const gpu::Buffer& staging, const gpu::Buffer& destination,
-                   uint64_t bytes, const ChunkSource& source, Progress* progress);
+                   uint64_t bytes, const ChunkSource& source, Progress* progress, uint64_t destination_offset = 0);
 
 }  // namespace fibscope

@@ -250,14 +250,17 @@ TEST_F(GpuBaselines, uploadFillsEveryTableThroughASmallStagingBuffer) {
   EXPECT_EQ(raw.pointCount(), t.pointCount());
   EXPECT_EQ(raw.segmentCount(), expected_segments);
 
+  // One chunk at the default chunk size: the points, then the end bits.
+  ASSERT_EQ(raw.chunkCount(), 1u);
+  const gpu::Buffer& chunk = raw.chunk(0).buffer;
   std::vector<float> points(t.positions.size());
-  gpu::downloadFromBuffer(context(), raw.points(), points.data(), points.size() * sizeof(float));
+  gpu::downloadFromBuffer(context(), chunk, points.data(), points.size() * sizeof(float));
   EXPECT_EQ(points, t.positions);
   std::vector<uint64_t> offsets(t.offsets.size());
   gpu::downloadFromBuffer(context(), raw.offsets(), offsets.data(), offsets.size() * sizeof(uint64_t));
   EXPECT_EQ(offsets, t.offsets);
   std::vector<uint32_t> ends((t.pointCount() + 31) / 32);
-  gpu::downloadFromBuffer(context(), raw.ends(), ends.data(), ends.size() * sizeof(uint32_t));
+  gpu::downloadFromBuffer(context(), chunk, ends.data(), ends.size() * sizeof(uint32_t), points.size() * sizeof(float));
   std::vector<uint32_t> expected_ends(ends.size(), 0);
   for (size_t s = 0; s < t.streamlineCount(); ++s)
     if (t.pointsIn(s) > 0) expected_ends[(t.offsets[s + 1] - 1) / 32] |= 1u << ((t.offsets[s + 1] - 1) % 32);
@@ -272,7 +275,8 @@ TEST_F(GpuBaselines, uploadFillsEveryTableThroughASmallStagingBuffer) {
   }
   shader::RawTractogram block{};
   gpu::downloadFromBuffer(context(), raw.blockBuffer(), &block, sizeof(block));
-  EXPECT_EQ(block.points, raw.points().address);
+  EXPECT_EQ(block.chunks, raw.chunkTable().address);
+  EXPECT_EQ(block.chunk_count, 1u);
   EXPECT_EQ(block.offsets, raw.offsets().address);
   EXPECT_EQ(block.point_count, t.pointCount());
   EXPECT_EQ(block.segment_count, expected_segments);
@@ -309,7 +313,9 @@ TEST_F(GpuBaselines, segmentsJoiningTwoStreamlinesAreNeverDrawnAndSegmentsAreInd
         const bool is_left = x < 32, lower_half = y >= 32;
         EXPECT_EQ(texel.fiber, is_left ? 0u : 1u);
         // The rows next to the middle point may fall to either segment.
-        if (y != 31 && y != 32) EXPECT_EQ(texel.segment, is_left == lower_half ? 0u : 1u) << x << ", " << y;
+        if (y != 31 && y != 32) {
+          EXPECT_EQ(texel.segment, is_left == lower_half ? 0u : 1u) << x << ", " << y;
+        }
         const std::array<float, 3> tangent = unpackTangent(texel.tangent);
         EXPECT_GT(is_left ? tangent[1] : -tangent[1], 0.9999f) << x << ", " << y;
         (x < 32 ? left_covered : right_covered)++;
@@ -354,33 +360,42 @@ TEST_F(GpuBaselines, anOversizeUploadFailsInOneLineBeforeAllocating) {
     EXPECT_NE(what.find("device-local heap 16.00 KiB"), std::string::npos) << what;
     EXPECT_EQ(what.find("one buffer"), std::string::npos) << what;
   }
-  // The heap is large enough, the points' buffer is not.
+  // The heap is large enough, a chunk of points (asked larger than the
+  // device allows) is not.
   DeviceLimits one_buffer = small;
   one_buffer.device_local_heap_bytes = uint64_t(1) << 40;
   one_buffer.max_buffer_bytes = 4096;
   try {
-    GpuRawTractogram::upload(context(), t, "big.tck", nullptr, &one_buffer);
+    GpuRawTractogram::upload(context(), t, "big.tck", nullptr, &one_buffer, kDatasetStagingBytes, 1 << 20);
     FAIL() << "a tractogram with a buffer above the largest buffer was uploaded";
   } catch (const Error& e) {
     const std::string what = e.what();
     EXPECT_EQ(what.find('\n'), std::string::npos) << what;
-    EXPECT_NE(what.find("the points need one buffer of"), std::string::npos) << what;
+    EXPECT_NE(what.find("a chunk of points needs one buffer of"), std::string::npos) << what;
     EXPECT_NE(what.find("largest buffer 4.00 KiB"), std::string::npos) << what;
   }
   // The size check alone: 8.1 G points (the paper's largest) need 97 GB of
-  // vertices, more than any single allocation of a 1 TiB-heap device with
-  // 4 GiB buffers, and the counts themselves are within the key's range.
+  // vertices, in chunks of at most 1 GiB they fit a 1 TiB-heap device with
+  // 4 GiB buffers, not one with 512 MiB buffers asked for 1 GiB chunks.
   DeviceLimits big;
   big.device_name = "bigvram";
   big.device_local_heap_bytes = uint64_t(1) << 40;
   big.max_allocation_bytes = uint64_t(4) << 30;
   big.max_buffer_bytes = uint64_t(4) << 30;
-  const uint64_t points = 8'100'000'000, streamlines = 10'000'000;
-  EXPECT_THROW(checkRawTractogramFits("x", streamlines, points, rawTractogramBytes(streamlines, points), big), Error);
-  big.max_allocation_bytes = big.max_buffer_bytes = uint64_t(1) << 40;
-  EXPECT_NO_THROW(checkRawTractogramFits("x", streamlines, points, rawTractogramBytes(streamlines, points), big));
+  const uint64_t streamlines = 1'000'000, points = 8'100'000'000;
+  std::vector<uint64_t> offsets(streamlines + 1);
+  for (uint64_t s = 0; s <= streamlines; ++s) offsets[s] = s * (points / streamlines);
+  const std::vector<RawChunkRange> chunks = planRawChunks("x", offsets, defaultRawChunkBytes(big));
+  // 12.125 bytes a point (with the end bits): 10932 streamlines of 8100
+  // points in a GiB, 92 chunks.
+  EXPECT_EQ(chunks.size(), 92u);
+  EXPECT_NO_THROW(checkRawTractogramFits("x", streamlines, points, rawTractogramBytes(streamlines, chunks), big));
+  big.max_allocation_bytes = big.max_buffer_bytes = uint64_t(512) << 20;
+  EXPECT_THROW(checkRawTractogramFits("x", streamlines, points, rawTractogramBytes(streamlines, chunks), big), Error);
   // 2^34 points do not fit the visibility key's payload, however large the device.
-  EXPECT_THROW(checkRawTractogramFits("x", 1, uint64_t(1) << 34, rawTractogramBytes(1, uint64_t(1) << 34), big), Error);
+  big.max_allocation_bytes = big.max_buffer_bytes = uint64_t(1) << 40;
+  const RawChunkRange huge{0, 1, 0, uint64_t(1) << 34};
+  EXPECT_THROW(checkRawTractogramFits("x", 1, uint64_t(1) << 34, rawTractogramBytes(1, {&huge, 1}), big), Error);
 }
 
 }  // namespace
