@@ -15,7 +15,6 @@
 #include <vector>
 
 #include "app/viewer/recent_files.h"
-#include "app/viewer/recent_files.h"
 #include "app/viewer/viewer_input.h"
 #include "app/viewer/viewer_script.h"
 #include "codec/compressor.h"
@@ -598,110 +597,6 @@ TEST_F(GpuViewer, failedSelectionExpectationIsAOneLineErrorNamingTheScriptLine) 
   const auto r = runViewer("--offscreen --size 64x48 --script " + script);
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find(script + ":3: expect-selected 3: 0 fibers are selected"), std::string::npos) << r.output;
-}
-
-// --- loading on the worker (model_loader.h) ---------------------------------
-
-TEST(ViewerScript, openAndWaitLoadedHoldUntilTheLoaderIsIdle) {
-  ScriptRunner runner(parseScript("open a.tck\nwait-loaded\nview axial\nquit\n", "s"));
-  const auto first = runner.nextFrame(/*loading=*/false);  // open is applied; the loader starts
-  ASSERT_EQ(first.size(), 1u);
-  EXPECT_EQ(std::get<OpenAction>(first[0]).path, "a.tck");
-  EXPECT_TRUE(runner.nextFrame(true).empty());
-  EXPECT_TRUE(runner.nextFrame(true).empty());
-  EXPECT_FALSE(runner.finished());
-  EXPECT_EQ(runner.nextFrame(false).size(), 2u);  // view, quit
-  EXPECT_TRUE(runner.finished());
-  EXPECT_THROW(parseScript("open\n", "s"), Error);
-  EXPECT_THROW(parseScript("wait-loaded 3\n", "s"), Error);
-}
-
-TEST(ViewerRecentFiles, newestFirstWithoutDuplicatesAtMostTen) {
-  std::vector<std::string> list;
-  for (int i = 0; i < 12; ++i) list = addRecentFile(std::move(list), "/data/t" + std::to_string(i) + ".tck");
-  list = addRecentFile(std::move(list), "/data/t5.tck");
-  ASSERT_EQ(list.size(), kMaxRecentFiles);
-  EXPECT_EQ(list[0], "/data/t5.tck");
-  EXPECT_EQ(list[1], "/data/t11.tck");
-  EXPECT_EQ(std::count(list.begin(), list.end(), "/data/t5.tck"), 1);
-  EXPECT_EQ(addRecentFile(list, "").size(), kMaxRecentFiles);  // the phantom is not a file
-  const auto relative = addRecentFile({}, "rel/x.tck");
-  ASSERT_EQ(relative.size(), 1u);
-  EXPECT_EQ(relative[0].front(), '/');
-}
-
-TEST(ViewerRecentFiles, savedListReadsBackAndMissingOrDamagedFilesAreHandled) {
-  test::TempDir dir;
-  const std::string a = dir.file("a.tck"), b = dir.file("b.tck"), json = dir.file("cache/recent_files.json");
-  test::writeBytes(a, "x");
-  test::writeBytes(b, "x");
-  ASSERT_EQ(saveRecentFiles(json, {b, a, dir.file("gone.tck")}), "");
-  EXPECT_EQ(loadRecentFiles(json), (std::vector<std::string>{b, a}));  // the missing one is dropped
-  EXPECT_EQ(loadRecentFiles(json, /*drop_missing=*/false).size(), 3u);
-  test::writeBytes(json, "{\"files\": [\"" + a + "\", 3, null");  // truncated
-  EXPECT_TRUE(loadRecentFiles(json).empty());
-  test::writeBytes(json, "{\"files\": [\"" + a + "\", 3]}");  // not a string: skipped
-  EXPECT_EQ(loadRecentFiles(json), std::vector<std::string>{a});
-  EXPECT_TRUE(loadRecentFiles(dir.file("none.json")).empty());
-}
-
-// A .tck whose header points past its end.
-void writeMalformedTck(const std::string& path) {
-  test::writeBytes(path, "mrtrix tracks\ncount: 5\ndatatype: Float32LE\nfile: . 200\nEND\n");
-}
-
-TEST_F(GpuViewer, scriptOpenOfAMalformedFileShowsTheErrorAndKeepsTheModel) {
-  const std::string bad = dir_.file("bad.tck"), script = dir_.file("s.txt"), scene = dir_.file("scene.png");
-  writeMalformedTck(bad);
-  test::writeBytes(script, "open " + bad + "\nwait-loaded\nwait 2\nscreenshot " + scene + " 96x64\nwait 1\nquit\n");
-  const auto r = runViewer("--offscreen --size 320x200 --script " + script);
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(r.output.find("fibscope view: " + bad + ": "), std::string::npos) << r.output;
-  const Png png = readOurPng(scene);
-  ASSERT_EQ(png.width, 96u);
-  EXPECT_GT(coverage(png, 0, 0, 96, 64), 0.05);  // the phantom is still drawn
-}
-
-TEST_F(GpuViewer, commandLineFileThatCannotBeReadEndsTheRunWithOneLine) {
-  const std::string bad = dir_.file("bad.tck");
-  writeMalformedTck(bad);
-  const auto r = runViewer("--offscreen --size 64x64 --frames 2 " + bad);
-  EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_EQ(lineCount(r.output), 1) << r.output;
-  EXPECT_NE(r.output.find(bad), std::string::npos) << r.output;
-}
-
-TEST_F(GpuViewer, secondOpenOfTheSameFileComesFromTheCache) {
-  const std::string tck = dir_.file("t.tck"), cache = dir_.file("cache");
-  ASSERT_EQ(test::runCommand(std::string(FIBSCOPE_EXE) + " phantom -n 200 " + tck).exit_code, 0);
-  const std::string png = dir_.file("x.png");
-  const auto first = runViewer("--offscreen --size 320x200 --frames 1 --screenshot " + png + " " + tck, "", cache);
-  ASSERT_EQ(first.exit_code, 0) << first.output;
-  EXPECT_NE(first.output.find("opened t.tck compressed in "), std::string::npos) << first.output;
-  const auto second = runViewer("--offscreen --size 320x200 --frames 1 --screenshot " + png + " " + tck, "", cache);
-  ASSERT_EQ(second.exit_code, 0) << second.output;
-  EXPECT_NE(second.output.find("opened t.tck from cache in "), std::string::npos) << second.output;
-  // --frames counts once the file is in: the screenshot shows it.
-  expectSceneAndPanels(readOurPng(png));
-  // The recent files list next to the cache names it.
-  EXPECT_EQ(loadRecentFiles(cache + "/recent_files.json"), std::vector<std::string>{tck});
-}
-
-TEST_F(GpuViewer, scriptLoadRunsOnTheWorkerWhileFramesGoOn) {
-  const std::string tck = dir_.file("big.tck"), script = dir_.file("s.txt"), scene = dir_.file("scene.png");
-  ASSERT_EQ(test::runCommand(std::string(FIBSCOPE_EXE) + " phantom -n 3000 " + tck).exit_code, 0);
-  test::writeBytes(script, "open " + tck + "\nwait-loaded\nscreenshot " + scene + " 96x64\nwait 1\nquit\n");
-  const auto r = runViewer("--offscreen --size 160x100 --script " + script);
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  const size_t at = r.output.find("opened big.tck compressed in ");
-  ASSERT_NE(at, std::string::npos) << r.output;
-  const size_t comma = r.output.find(" in all, ", at);
-  ASSERT_NE(comma, std::string::npos) << r.output;
-  const int frames = std::atoi(r.output.c_str() + comma + 9);
-  EXPECT_GE(frames, 2) << "frames drawn while the file was compressed: " << r.output;
-  const Png png = readOurPng(scene);
-  ASSERT_EQ(png.width, 96u);
-  EXPECT_GT(coverage(png, 0, 0, 96, 64), 0.05);
 }
 
 // --- loading on the worker (model_loader.h) ---------------------------------
