@@ -1,8 +1,10 @@
 // The decode + raster pass of fiblet_raster.comp with the scan of the runs
 // done by subgroup shuffles (no shared memory, no barriers), for devices
-// whose subgroup size equals the lanes per fiblet and that support
-// KHR_shader_subgroup_shuffle_relative in compute shaders (lavapipe's 8,
-// NVIDIA's 32, AMD's 64). Chosen by createFibletPasses.
+// whose subgroup size is a multiple of the lanes per fiblet and that support
+// KHR_shader_subgroup_shuffle_relative in compute shaders: a subgroup holds
+// subgroup size / LANES fiblets (lavapipe: 8 lanes, one fiblet per subgroup;
+// NVIDIA: 8 lanes, four fiblets per 32-wide subgroup). Chosen by
+// createFibletPasses.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_buffer_reference : require

@@ -43,9 +43,11 @@ FibletTransform identityTransform() {
 void main() {
   const FibletDataset ds = DatasetRef(pc.dataset).ds;
 #if FIBLET_SUBGROUP_SCAN
-  // One fiblet per subgroup (LANES is the subgroup size).
-  const uint slot = gl_SubgroupID;
-  const uint lane = gl_SubgroupInvocationID;
+  // gl_SubgroupSize / LANES fiblets per subgroup, each in a cluster of LANES
+  // consecutive invocations; the scan's `lane >= offset` guard keeps every
+  // cluster to itself (a shuffle from the cluster below is never used).
+  const uint slot = gl_SubgroupID * (gl_SubgroupSize / LANES) + gl_SubgroupInvocationID / LANES;
+  const uint lane = gl_SubgroupInvocationID % LANES;
 #else
   const uint slot = gl_LocalInvocationID.x / LANES;  // which fiblet of the workgroup
   const uint lane = gl_LocalInvocationID.x % LANES;
@@ -87,13 +89,20 @@ void main() {
 
   // 1. The run's product, and its local prefix translations: local[j] is
   //    the point first + j + 1 in the frame of the run's start.
+  //    The loops run over the constant `run` (LANES is a specialization
+  //    constant) with a guard instead of up to the data-dependent `end`, so
+  //    the compiler can unroll them and keep local[] in registers: indexed
+  //    by a loop counter of unknown range it went to (slower) local memory.
   vec3 local[kMaxRun];
   FibletTransform s = identityTransform();
-  for (uint k = first; k < end; ++k) {
-    const FibletTransform t = k == 0u ? fibletInitialTransform(p0, p1, v)
-                                      : fibletTableTransform(directions, fibletRecordByte(records, base, fibletCodeByte(k + 1u)));
-    s = k == first ? t : fibletCompose(s, t);
-    local[k - first] = s.t;
+  for (uint j = 0u; j < run; ++j) {
+    const uint k = first + j;
+    if (k < end) {
+      const FibletTransform t = k == 0u ? fibletInitialTransform(p0, p1, v)
+                                        : fibletTableTransform(directions, fibletRecordByte(records, base, fibletCodeByte(k + 1u)));
+      s = j == 0u ? t : fibletCompose(s, t);
+      local[j] = s.t;
+    }
   }
 #if FIBLET_SUBGROUP_SCAN
   // 2. Inclusive scan of the runs across the subgroup (shuffles, no shared
@@ -131,13 +140,16 @@ void main() {
   vec4 a = cameraTransformPoint(cam.view_projection, a_world);
   const bool cache = pc.tangents != 0ul;
   UintsOutRef tangents = UintsOutRef(pc.tangents);
-  for (uint k = first; k < end; ++k) {
-    const vec3 b_world = fibletToWorld(ds, fibletRotate(e, local[k - first]) + e.t);  // point k + 1
-    const vec4 b = cameraTransformPoint(cam.view_projection, b_world);
-    rasterClipSegment(vis, cam, a, b, (uint64_t(fiblet) << kKeySegmentBits) | uint64_t(k));
-    if (cache) tangents.values[fiblet * kSlots + k] = packSegmentTangent(b_world - a_world);
-    a = b;
-    a_world = b_world;
+  for (uint j = 0u; j < run; ++j) {
+    const uint k = first + j;
+    if (k < end) {
+      const vec3 b_world = fibletToWorld(ds, fibletRotate(e, local[j]) + e.t);  // point k + 1
+      const vec4 b = cameraTransformPoint(cam.view_projection, b_world);
+      rasterClipSegment(vis, cam, a, b, (uint64_t(fiblet) << kKeySegmentBits) | uint64_t(k));
+      if (cache) tangents.values[fiblet * kSlots + k] = packSegmentTangent(b_world - a_world);
+      a = b;
+      a_world = b_world;
+    }
   }
   // The joining segment, drawn by the lane that owns the last point (point
   // `used`: lane 0 when the fiblet has one point).

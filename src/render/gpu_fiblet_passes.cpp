@@ -1,5 +1,7 @@
 #include "render/gpu_fiblet_passes.h"
 
+#include <algorithm>
+
 #include <string>
 
 #include "core/error.h"
@@ -8,7 +10,23 @@
 
 namespace fibscope {
 
+namespace {
+
+// A subgroup scan needs relative shuffles and clusters of `lanes` that tile
+// the subgroup.
+bool subgroupScanFits(const gpu::DeviceInfo& info, uint32_t lanes) {
+  return info.subgroup_shuffle_relative && lanes <= info.subgroup_size && info.subgroup_size % lanes == 0;
+}
+
+}  // namespace
+
 uint32_t defaultRasterLanes(const gpu::VulkanContext& context) {
+  // 8 lanes (8 points each) wherever subgroup shuffles can scan them: the
+  // fewest compositions per point. On an H100 (32-wide subgroups, 500 k
+  // fibers, 1080p) the raster took 14.8 ms with 8 lanes and four fiblets per
+  // subgroup, 16.3 ms with 16 lanes, 18.6 ms with 32 (one fiblet per
+  // subgroup, the paper's layout); docs/BENCHMARKS.md.
+  if (subgroupScanFits(context.info(), 8)) return 8;
   uint32_t lanes = 8;
   while (lanes < 64 && lanes < context.info().subgroup_size) lanes *= 2;
   return lanes;
@@ -18,10 +36,11 @@ FibletPasses createFibletPasses(const gpu::VulkanContext& context, uint32_t rast
   if (raster_lanes == 0) raster_lanes = defaultRasterLanes(context);
   if (raster_lanes != 8 && raster_lanes != 16 && raster_lanes != 32 && raster_lanes != 64)
     throw Error("fiblet raster: lanes per fiblet must be 8, 16, 32 or 64, got " + std::to_string(raster_lanes));
-  const bool subgroup_ok = context.info().subgroup_shuffle_relative && context.info().subgroup_size == raster_lanes;
+  const bool subgroup_ok = subgroupScanFits(context.info(), raster_lanes);
   if (scan == RasterScan::Subgroup && !subgroup_ok)
-    throw Error("fiblet raster: a subgroup scan needs " + std::to_string(raster_lanes) +
-                "-wide subgroups with relative shuffles; " + context.info().name + " has " +
+    throw Error("fiblet raster: a subgroup scan of " + std::to_string(raster_lanes) +
+                " lanes needs subgroups a multiple of that wide with relative shuffles; " + context.info().name +
+                " has " +
                 std::to_string(context.info().subgroup_size) + "-wide subgroups" +
                 (context.info().subgroup_shuffle_relative ? "" : " without relative shuffles"));
   FibletPasses passes;
@@ -29,9 +48,15 @@ FibletPasses createFibletPasses(const gpu::VulkanContext& context, uint32_t rast
   passes.raster_subgroup_scan = scan == RasterScan::Subgroup || (scan == RasterScan::Auto && subgroup_ok);
   try {
     // CPU devices (lavapipe) pay about a microsecond per workgroup: pack
-    // 64 invocations' worth of fiblets into each; GPUs get the paper's one
+    // 64 invocations' worth of fiblets into each. GPUs: one subgroup per
+    // workgroup with the subgroup scan (fastest on the H100: two or four
+    // subgroups per workgroup measured 7-11 % slower), else the paper's one
     // workgroup per fiblet.
-    passes.raster_fiblets_per_group = context.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 64 / raster_lanes : 1;
+    const uint32_t subgroup = context.info().subgroup_size;
+    if (context.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU)
+      passes.raster_fiblets_per_group = std::max<uint32_t>(64, subgroup) / raster_lanes;
+    else
+      passes.raster_fiblets_per_group = passes.raster_subgroup_scan ? subgroup / raster_lanes : 1;
     const uint32_t specialization[] = {raster_lanes, passes.raster_fiblets_per_group,
                                        raster_lanes * passes.raster_fiblets_per_group};
     passes.raster = gpu::createComputePipeline(

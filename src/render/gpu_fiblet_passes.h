@@ -21,24 +21,25 @@ struct FibletPasses {
   gpu::ComputePipeline raster;   // fiblet_raster.comp
   gpu::ComputePipeline resolve;  // fiblet_resolve.comp
   uint32_t raster_lanes = 0;     // invocations per fiblet in the raster
-  uint32_t raster_fiblets_per_group = 1;  // fiblets per raster workgroup (1 on GPUs)
+  uint32_t raster_fiblets_per_group = 1;  // fiblets per raster workgroup
   bool raster_subgroup_scan = false;      // fiblet_raster_subgroup.comp (else fiblet_raster.comp)
 };
 
 // How the raster scans a fiblet's runs: by subgroup shuffles where the lanes
-// per fiblet are exactly one subgroup and the device has relative shuffles
-// (Auto), or in shared memory with barriers (any subgroup size).
+// per fiblet tile a subgroup (subgroup size a multiple of the lanes) and the
+// device has relative shuffles (Auto), or in shared memory with barriers
+// (any subgroup size).
 enum class RasterScan : uint8_t { Auto, SharedMemory, Subgroup };
 
-// The raster's invocations per fiblet for a device: its subgroup size
-// clamped to [8, 64] (a fiblet fills whole subgroups; lavapipe's 8 lanes
-// each decode 8 points, a 64-wide GPU one point per lane).
+// The raster's invocations per fiblet for a device: 8 where a subgroup scan
+// fits (each lane decodes 8 points; several fiblets per subgroup on GPUs),
+// else its subgroup size clamped to [8, 64].
 uint32_t defaultRasterLanes(const gpu::VulkanContext& context);
 
 // `raster_lanes`: 8, 16, 32 or 64; 0 = defaultRasterLanes. Throws Error for
 // other values, for RasterScan::Subgroup where the device cannot (lanes not
-// its subgroup size, no relative shuffles), or when a pipeline cannot be
-// created.
+// dividing its subgroup size, no relative shuffles), or when a pipeline
+// cannot be created.
 FibletPasses createFibletPasses(const gpu::VulkanContext& context, uint32_t raster_lanes = 0,
                                 RasterScan scan = RasterScan::Auto);
 void destroyFibletPasses(const gpu::VulkanContext& context, FibletPasses& passes);
