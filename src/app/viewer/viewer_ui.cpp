@@ -38,15 +38,41 @@ void settingsPanel(ViewerState& state, std::vector<ViewerAction>& actions) {
   RenderSettings& s = state.settings;
   enumCombo("pipeline", s.pipeline, 3, renderPipelineName);
   if (s.pipeline == RenderPipeline::Compute) enumCombo("culling", s.culling, 3, cullingModeName);
+  if (s.pipeline == RenderPipeline::Compute && s.culling != CullingMode::None)
+    ImGui::SliderFloat("LoD below", &s.lod_pixels, 0.0f, 16.0f, "%.1f px");
   ImGui::SliderFloat("line width", &s.line_width_px, 1.0f, 4.0f, "%.1f px");
-  enumCombo("colour", s.color, 3, colorModeName);
+  enumCombo("colour", s.color, 5, colorModeName);
   if (s.color == ColorMode::Solid) ImGui::ColorEdit3("solid colour", s.solid_color.data());
+  if (s.color == ColorMode::Scalar) {
+    ImGui::TextDisabled("scalar: fiber length (mm)");
+    enumCombo("colormap", s.colormap, 4, colormapName);
+    ImGui::DragFloatRange2("range", &s.scalar_min, &s.scalar_max, 0.5f, 0.0f, 0.0f, "%.1f", "%.1f");
+    if (s.scalar_max < s.scalar_min) s.scalar_max = s.scalar_min;
+    if (state.scalar_data_min <= state.scalar_data_max) {
+      ImGui::SameLine();
+      if (ImGui::SmallButton("fit")) {
+        s.scalar_min = state.scalar_data_min;
+        s.scalar_max = state.scalar_data_max;
+      }
+    }
+  }
   enumCombo("lighting", s.lighting, 2, lightingName);
-  ImGui::Checkbox("SSAO", &s.ssao);
+  if (s.lighting == Lighting::IlluminatedLines && ImGui::TreeNode("light")) {
+    ImGui::SliderFloat("ambient", &s.light_ambient, 0.0f, 1.0f, "%.2f");
+    ImGui::SliderFloat("diffuse", &s.light_diffuse, 0.0f, 1.0f, "%.2f");
+    ImGui::SliderFloat("specular", &s.light_specular, 0.0f, 1.0f, "%.2f");
+    ImGui::SliderFloat("shininess", &s.light_shininess, 1.0f, 128.0f, "%.0f");
+    ImGui::TreePop();
+  }
+  ImGui::Checkbox("ambient occlusion", &s.ssao);
   if (s.ssao) {
     ImGui::SliderFloat("AO radius", &s.ssao_radius_px, 1.0f, 40.0f, "%.0f px");
     ImGui::SliderFloat("AO strength", &s.ssao_strength, 0.0f, 1.0f, "%.2f");
+    ImGui::SliderInt("AO scales", &s.ao_scales, 1, 4);
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("multi-scale AO: radii r, 2r, 4r, 8r combined");
+    ImGui::SliderFloat("AO range", &s.ssao_range_mm, 1.0f, 40.0f, "%.0f mm");
   }
+  ImGui::Checkbox("FXAA", &s.fxaa);
   ImGui::ColorEdit3("background", s.background.data());
   float fov = float(state.fov_deg);
   if (ImGui::SliderFloat("field of view", &fov, 10.0f, 90.0f, "%.0f deg")) actions.push_back(FovAction{fov});

@@ -15,8 +15,10 @@ void drawSelectionPanel(ViewerState& state, std::vector<ViewerAction>& actions) 
   SelectionInfo& selection = state.selection;
   if (selection.fibers.empty()) return;
   const ImGuiViewport* viewport = ImGui::GetMainViewport();
-  ImGui::SetNextWindowPos(ImVec2(viewport->WorkPos.x + viewport->WorkSize.x - 10, viewport->WorkPos.y + 160),
-                          ImGuiCond_FirstUseEver, ImVec2(1, 0));
+  // Bottom right: the performance overlay holds the top right.
+  ImGui::SetNextWindowPos(ImVec2(viewport->WorkPos.x + viewport->WorkSize.x - 10,
+                                 viewport->WorkPos.y + viewport->WorkSize.y - 40),
+                          ImGuiCond_FirstUseEver, ImVec2(1, 1));
   ImGui::SetNextWindowSize(ImVec2(260, 0), ImGuiCond_FirstUseEver);
   if (!ImGui::Begin("Selection", &state.show_selection)) {
     ImGui::End();
