@@ -1,5 +1,5 @@
 // `fibscope view [FILE...] [--size WxH] [--screenshot OUT.png --frames N]
-// [--script FILE] [--offscreen] [--no-vsync] [--validate] [--device NAME]
+// [--script FILE] [--offscreen] [--no-vsync] [--orbit DEG] [--validate] [--device NAME]
 // [--phantom-streamlines N] [render settings]`: the interactive viewer
 // (src/app/viewer/). Without a display it renders offscreen, so scripts and
 // tests run anywhere Vulkan does.
@@ -24,6 +24,7 @@ struct ViewCommandOptions {
   std::string script;
   bool offscreen = false;
   bool no_vsync = false;
+  double orbit_deg = 0;
 };
 
 void runView(ViewCommandOptions o) {
@@ -41,6 +42,9 @@ void runView(ViewCommandOptions o) {
   v.script = o.script;
   v.offscreen = o.offscreen;
   v.vsync = !o.no_vsync;
+  if (!(o.orbit_deg >= -90 && o.orbit_deg <= 90))
+    throw Error("--orbit: expected degrees per frame in [-90, 90], got " + std::to_string(o.orbit_deg));
+  v.orbit_deg_per_frame = o.orbit_deg;
   v.validate = o.render.validate;
   v.device = o.render.device;
   runViewer(v);
@@ -61,6 +65,9 @@ void addViewCommand(CLI::App& app) {
   cmd->add_option("--script", o->script, "Run viewer commands from this file (one a line)");
   cmd->add_flag("--offscreen", o->offscreen, "No window: render into an offscreen image");
   cmd->add_flag("--no-vsync", o->no_vsync, "Present without waiting for vertical sync (mailbox or immediate)");
+  cmd->add_option("--orbit", o->orbit_deg,
+                  "Turn the camera this many degrees per frame about the view's up axis (the fiblets paper's "
+                  "benchmark turns 1.14); the frame times are printed at exit");
   cmd->callback([o] { runView(*o); });
 }
 

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <future>
@@ -51,8 +52,13 @@ struct ViewerModel {
   GpuRawTractogram raw;
   bool has_raw = false;
 
-  // What a frame of this model draws.
-  GpuScene gpuScene() const { return GpuScene{&fiblets, has_raw ? &raw : nullptr}; }
+  // What a frame of this model draws; the per-fiber scalar of the scalar
+  // colour mode is the fiber length, already on the device with the fiblets.
+  GpuScene gpuScene() const {
+    GpuScene scene{&fiblets, has_raw ? &raw : nullptr};
+    scene.fiber_scalars = fiblets.fiberLength().address;
+    return scene;
+  }
 };
 
 // A reader that stops at the next chunk once `cancel` is set (a raw decode
@@ -138,6 +144,8 @@ class ViewerApp {
   bool drawFrame(uint32_t width, uint32_t height, double dt);
   void recordFrame(VkCommandBuffer cmd, uint32_t width, uint32_t height, const Camera& camera);
   void takeScreenshot(const ScreenshotAction& shot);
+  // With --orbit: frames, mean / median / p95 wall time per frame, to stderr.
+  void printFrameSummary(std::vector<double> frame_ms) const;
   // Picking and the selection (viewer_selection.h), between frames.
   void syncSelection();
   void pickAt(const PickAction& pick);
@@ -397,6 +405,25 @@ void ViewerApp::frameActiveModel() {
   const ModelData& data = *scenes_[size_t(state_.active_model)]->data;
   controller_.frame(data.bounds, data.sample);
   framed_model_ = state_.active_model;
+  // The scalar colour mode's range follows the model shown: its fibers'
+  // lengths (finite ones: a damaged table must not make the range NaN).
+  state_.scalar_data_min = 1, state_.scalar_data_max = 0;
+  if (const FblSection* section = data.fbl.find(kFblSectionFiberLength)) {
+    try {
+      for (float v : data.fbl.array<float>(*section))
+        if (std::isfinite(v)) {
+          if (state_.scalar_data_min > state_.scalar_data_max) state_.scalar_data_min = state_.scalar_data_max = v;
+          state_.scalar_data_min = std::min(state_.scalar_data_min, v);
+          state_.scalar_data_max = std::max(state_.scalar_data_max, v);
+        }
+    } catch (const Error& e) {
+      state_.status = e.what();
+    }
+  }
+  if (state_.scalar_data_min <= state_.scalar_data_max) {
+    state_.settings.scalar_min = state_.scalar_data_min;
+    state_.settings.scalar_max = state_.scalar_data_max;
+  }
 }
 
 const ViewerModel* ViewerApp::activeScene() {
@@ -712,6 +739,7 @@ bool ViewerApp::drawFrame(uint32_t width, uint32_t height, double dt) {
 
 void ViewerApp::run() {
   uint32_t frames_done = 0;
+  std::vector<double> frame_times_ms;
   frame_start_ = Clock::now();
   while (!quit_) {
     uint32_t width = options_.width, height = options_.height;
@@ -743,12 +771,19 @@ void ViewerApp::run() {
           apply(action);
     if (!starting)
       for (const ViewerAction& action : script_.nextFrame(loader_->busy())) apply(action);
+    if (!starting && options_.orbit_deg_per_frame != 0)
+      controller_.rotate(options_.orbit_deg_per_frame / OrbitController::kDegreesPerPixel, 0);
     // A quit still draws this frame: a screenshot asked for with it is taken.
     controller_.update(dt);
 
     if (drawFrame(width, height, dt)) {
       ++frames_drawn_;
-      if (!starting) ++frames_done;
+      if (!starting) {
+        ++frames_done;
+        // The wall time since the previous frame began (the first counted
+        // frame's interval still holds loading: left out).
+        if (frames_done > 1) frame_times_ms.push_back(last_frame_ms_);
+      }
     }
     // Offscreen nothing paces the frames: while a load runs, leave the
     // cores to the worker (a window is paced by vsync).
@@ -765,12 +800,35 @@ void ViewerApp::run() {
     writePngRgba(options_.screenshot, presentation_.width, presentation_.height,
                  downloadPresentation(*context_, presentation_));
   }
+  if (options_.orbit_deg_per_frame != 0) printFrameSummary(frame_times_ms);
   if (options_.validate) {
     const int errors = context_->log().errors(), warnings = context_->log().warnings();
     if (errors + warnings > 0)
       throw Error("validation layers reported " + std::to_string(errors) + " errors and " + std::to_string(warnings) +
                   " warnings (printed above)");
   }
+}
+
+void ViewerApp::printFrameSummary(std::vector<double> frame_ms) const {
+  if (frame_ms.empty()) {
+    std::fprintf(stderr, "fibscope view: no frame timed\n");
+    return;
+  }
+  std::sort(frame_ms.begin(), frame_ms.end());
+  double sum = 0;
+  for (double ms : frame_ms) sum += ms;
+  const double mean = sum / double(frame_ms.size());
+  const double median = frame_ms[frame_ms.size() / 2];
+  const double p95 = frame_ms[std::min(frame_ms.size() - 1, size_t(double(frame_ms.size()) * 0.95))];
+  // GPU time of the frames still in the overlay's history.
+  double gpu = 0;
+  for (const FrameRecord& r : state_.frames) gpu += r.gpu.gpu_ms;
+  if (!state_.frames.empty()) gpu /= double(state_.frames.size());
+  std::fprintf(stderr,
+               "fibscope view: %zu frames at %ux%u on %s: frame (wall) mean %.2f ms, median %.2f ms, p95 %.2f ms "
+               "(%.1f fps median); GPU mean %.2f ms over the last %zu\n",
+               frame_ms.size(), presentation_.width, presentation_.height, context_->info().name.c_str(), mean, median,
+               p95, median > 0 ? 1000.0 / median : 0.0, gpu, state_.frames.size());
 }
 
 }  // namespace

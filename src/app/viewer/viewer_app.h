@@ -23,6 +23,11 @@ struct ViewerOptions {
   std::string script;      // viewer_script.h
   bool offscreen = false;  // no window even when there is a display
   bool vsync = true;       // false: mailbox or immediate presentation where available
+  // Degrees per frame the camera turns about the view's up axis (0: still):
+  // a benchmark session like `fibscope bench`'s orbit, through the whole
+  // viewer frame loop (panels, presentation). With it, a summary of the
+  // frame times is printed at exit.
+  double orbit_deg_per_frame = 0;
   bool validate = false;   // validation layers on; any message fails the run
   std::string device;
   RenderSettings settings;
