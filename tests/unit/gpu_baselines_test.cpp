@@ -215,8 +215,13 @@ TEST_F(GpuBaselines, linesCoverTheCpuReferenceToAboutAPixel) {
       // the nearer one (not a depth-order error).
       EXPECT_GE(double(ids.same_fiber), (width == 1.0f ? 0.85 : 0.65) * double(ids.both));
       EXPECT_GE(double(ids.gpu_farther), 0.9 * double(ids.differentFiber()));
-      // Same segment: the same line, so the same interpolated depth.
-      EXPECT_LE(ids.max_depth_error, 1e-4);
+      // Same segment: the same line, so the same interpolated depth, where
+      // lines are parallelograms (strictLines: lavapipe). Bresenham lines
+      // (no strictLines: NVIDIA) may light a pixel up to half a pixel past
+      // a segment's end, where the depth is extrapolated along the line: an
+      // H100 measured up to 4.7e-4 on these views (sub-pixel segments seen
+      // almost end-on change depth fastest).
+      EXPECT_LE(ids.max_depth_error, context().limits().strictLines ? 1e-4 : 2e-3);
       // Empty texels are exactly the clear value.
       for (const shader::GBufferTexel& t : r.texels) {
         if (t.fiber != shader::kNoFiberId) continue;
