@@ -420,7 +420,7 @@ void ViewerApp::frameActiveModel() {
       state_.status = e.what();
     }
   }
-  if (state_.scalar_data_min <= state_.scalar_data_max) {
+  if (!options_.keep_scalar_range && state_.scalar_data_min <= state_.scalar_data_max) {
     state_.settings.scalar_min = state_.scalar_data_min;
     state_.settings.scalar_max = state_.scalar_data_max;
   }

@@ -28,6 +28,9 @@ struct ViewerOptions {
   // viewer frame loop (panels, presentation). With it, a summary of the
   // frame times is printed at exit.
   double orbit_deg_per_frame = 0;
+  // settings' scalar range was given (--scalar-range): kept, where otherwise
+  // each model shown sets it to its fibers' lengths.
+  bool keep_scalar_range = false;
   bool validate = false;   // validation layers on; any message fails the run
   std::string device;
   RenderSettings settings;
