@@ -16,6 +16,7 @@
 
 #include "app/model_loader.h"
 #include "app/open_input.h"
+#include "app/viewer/adaptive_detail.h"
 #include "app/viewer/imgui_layer.h"
 #include "app/viewer/presentation.h"
 #include "app/viewer/recent_files.h"
@@ -180,6 +181,12 @@ class ViewerApp {
   VkCommandBuffer cmd_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;
   bool in_flight_ = false;
+  // Adaptive detail (recordFrame, adaptive_detail.h).
+  bool frame_coarse_ = false;      // the frame being recorded
+  bool submitted_coarse_ = false;  // the frame in flight
+  Clock::time_point submitted_at_;
+  double last_full_frame_ms_ = 0;
+  Camera last_camera_;  // of the last frame recorded
   Clock::time_point frame_start_;
   double last_frame_ms_ = 0;
 
@@ -622,6 +629,11 @@ void ViewerApp::finishFrame() {
   if (!in_flight_) return;
   VK_CHECK(vkWaitForFences(context_->device(), 1, &fence_, VK_TRUE, UINT64_MAX));
   in_flight_ = false;
+  // Submission to completion (an upper bound of the GPU's time: lavapipe's
+  // timestamps are not trusted) of the last full-detail frame.
+  if (!submitted_coarse_)
+    last_full_frame_ms_ = std::chrono::duration<double, std::milli>(Clock::now() - submitted_at_).count();
+  state_.coarse_frame = submitted_coarse_;
   FrameRecord record;
   record.frame_ms = last_frame_ms_;
   record.gpu = renderer_->collect();
@@ -643,8 +655,19 @@ void ViewerApp::resizeTo(uint32_t width, uint32_t height) {
 void ViewerApp::recordFrame(VkCommandBuffer cmd, uint32_t width, uint32_t height, const Camera& camera) {
   const ViewerModel* scene = activeScene();
   drawn_dataset_ = nullptr;
+  frame_coarse_ = false;
   if (scene) {
-    renderer_->record(cmd, camera, drawSettings(*scene), withSelection(scene->gpuScene()));
+    RenderSettings settings = drawSettings(*scene);
+    // Adaptive detail (adaptive_detail.h). Moving: the camera differs from
+    // the last frame's (slow frames settle the controller's smoothing within
+    // one update, so animating() alone would miss a steady orbit).
+    const bool moving = controller_.animating() || !sameView(camera, last_camera_);
+    last_camera_ = camera;
+    if (drawCoarse(state_.adaptive_detail, settings, moving, last_full_frame_ms_)) {
+      settings = coarseSettings(settings, state_.moving_lod_px);
+      frame_coarse_ = true;
+    }
+    renderer_->record(cmd, camera, settings, withSelection(scene->gpuScene()));
     drawn_dataset_ = &scene->fiblets;
   } else {
     // Nothing to draw: the background alone (RGBA8, R in the low byte).
@@ -719,6 +742,8 @@ bool ViewerApp::drawFrame(uint32_t width, uint32_t height, double dt) {
   VK_CHECK(vkResetFences(context_->device(), 1, &fence_));
   gpu::throwIfFailed(vkQueueSubmit(context_->queue(), 1, &submit, fence_), "vkQueueSubmit (frame)");
   in_flight_ = true;
+  submitted_at_ = Clock::now();
+  submitted_coarse_ = frame_coarse_;
   if (window_ && gpu::presentSwapchainImage(*context_, swapchain_, image_index) == gpu::SwapchainStatus::OutOfDate)
     swapchain_stale_ = true;
 

@@ -72,6 +72,12 @@ struct SelectionInfo {
 struct ViewerState {
   RenderSettings settings;
   double fov_deg = 30;
+  // Adaptive detail: where a full frame takes over 100 ms, frames drawn while
+  // the camera moves use the far-view LoD below moving_lod_px (fiblets as
+  // one segment); the full detail returns when the camera stops.
+  bool adaptive_detail = true;
+  float moving_lod_px = 160.0f;
+  bool coarse_frame = false;  // the last frame shown was such a coarse one
   // The active model's per-fiber scalar (fiber length, mm) range, for the
   // scalar colour mode's "fit" button; min > max while unknown.
   float scalar_data_min = 1, scalar_data_max = 0;

@@ -73,6 +73,11 @@ void settingsPanel(ViewerState& state, std::vector<ViewerAction>& actions) {
     ImGui::SliderFloat("AO range", &s.ssao_range_mm, 1.0f, 40.0f, "%.0f mm");
   }
   ImGui::Checkbox("FXAA", &s.fxaa);
+  ImGui::Checkbox("coarse while moving", &state.adaptive_detail);
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("where a full frame takes over 100 ms: moves drawn with fiblets under the LoD size as one "
+                      "segment; full detail when the camera stops");
+  if (state.adaptive_detail) ImGui::SliderFloat("moving LoD", &state.moving_lod_px, 4.0f, 512.0f, "%.0f px");
   ImGui::ColorEdit3("background", s.background.data());
   float fov = float(state.fov_deg);
   if (ImGui::SliderFloat("field of view", &fov, 10.0f, 90.0f, "%.0f deg")) actions.push_back(FovAction{fov});
@@ -133,6 +138,7 @@ void performanceOverlay(ViewerState& state) {
   gpu_ms /= double(n);
   ImGui::Text("frame %.1f ms (%.0f fps)", frame_ms, frame_ms > 0 ? 1000.0 / frame_ms : 0.0);
   ImGui::Text("GPU   %.1f ms", gpu_ms);
+  if (state.coarse_frame) ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "moving: coarse (LoD %.0f px)", state.moving_lod_px);
   float history[ViewerState::kFrameHistory];
   for (size_t i = 0; i < state.frames.size(); ++i) history[i] = float(state.frames[i].frame_ms);
   ImGui::PlotLines("##frames", history, int(state.frames.size()), 0, nullptr, 0.0f, FLT_MAX, ImVec2(220, 40));

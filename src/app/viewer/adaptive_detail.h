@@ -1,0 +1,33 @@
+// Adaptive detail: where a full-detail frame is slow (a CPU device such as
+// lavapipe, or a model far larger than the GPU draws at interactive rates),
+// frames drawn while the camera moves trade detail for time, so orbiting
+// answers the mouse; the first frame after the camera stops has the full
+// detail again. Pure functions: no Vulkan, no ImGui.
+#pragma once
+
+#include "render/camera.h"
+#include "render/render_settings.h"
+
+namespace fibscope {
+
+// A full-detail frame slower than this (submission to completion, ms) makes
+// the moves coarse.
+inline constexpr double kSlowFrameMs = 100.0;
+
+// Whether two cameras show the same view (same eye, target, up and field
+// of view; the image size is not compared).
+bool sameView(const Camera& a, const Camera& b);
+
+// Whether this frame is drawn coarse: adaptive detail on, the compute
+// pipeline (the baselines have no LoD), the camera moving, and the last
+// full-detail frame slower than kSlowFrameMs.
+bool drawCoarse(bool adaptive, const RenderSettings& settings, bool moving, double last_full_frame_ms);
+
+// The settings of a coarse frame: fiblets projected smaller than
+// `moving_lod_px` (at least the settings' own LoD size) drawn as one segment,
+// frustum culling only (one cull pass: the LoD lives in the cull; an
+// occlusion pass has little left to cull), no ambient occlusion (two
+// full-screen passes and a blur, a large share of a coarse frame on a CPU).
+RenderSettings coarseSettings(RenderSettings settings, float moving_lod_px);
+
+}  // namespace fibscope
