@@ -21,9 +21,6 @@ Vec3d cross(Vec3d a, Vec3d b) {
 Vec3d unit(Vec3d a) { return scale(a, 1.0 / length(a)); }
 double radians(double deg) { return deg * std::numbers::pi / 180.0; }
 
-Vec3d centreOf(const Bounds& b) {
-  return {(b.min[0] + b.max[0]) / 2, (b.min[1] + b.max[1]) / 2, (b.min[2] + b.max[2]) / 2};
-}
 std::array<Vec3d, 8> cornersOf(const Bounds& b) {
   std::array<Vec3d, 8> corners;
   for (int i = 0; i < 8; ++i)
