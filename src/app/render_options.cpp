@@ -27,6 +27,10 @@ void addRenderCliOptions(CLI::App* cmd, RenderCliOptions& o) {
   cmd->add_option("--ao-scales", o.ao_scales, "Multi-scale AO: 1 to 4 radii (r, 2r, 4r, 8r)")->capture_default_str();
   cmd->add_flag("--fxaa", o.fxaa, "Fast approximate anti-aliasing of the image");
   cmd->add_option("--line-width", o.line_width, "Line width in pixels, 1 to 4")->capture_default_str();
+  cmd->add_option("--lod-pixels", o.lod_pixels,
+                  "Far-view LoD: fiblets whose bounding sphere projects smaller are drawn as one segment "
+                  "(frustum and two-phase culling; 0: off)")
+      ->capture_default_str();
   cmd->add_option("--background", o.background, "Background colour R,G,B in [0, 1]")->capture_default_str();
   cmd->add_option("--device", o.device, "Vulkan device whose name contains this");
   cmd->add_flag("--validate", o.validate, "Vulkan validation layers on; any message is an error");
@@ -66,6 +70,9 @@ RenderSettings renderSettingsFrom(const RenderCliOptions& o) {
   if (!(o.line_width >= 1.0f && o.line_width <= 4.0f))
     throw Error("--line-width: expected 1 to 4 pixels, got " + std::to_string(o.line_width));
   s.line_width_px = o.line_width;
+  if (!(o.lod_pixels >= 0.0f && o.lod_pixels <= 4096.0f))
+    throw Error("--lod-pixels: expected 0 to 4096 pixels, got " + std::to_string(o.lod_pixels));
+  s.lod_pixels = o.lod_pixels;
   float r = 0, g = 0, b = 0;
   char rest = 0;
   if (std::sscanf(o.background.c_str(), "%f,%f,%f%c", &r, &g, &b, &rest) != 3 || !(r >= 0 && r <= 1) ||

@@ -33,6 +33,7 @@ struct RenderCliOptions {
   std::string colormap = "viridis";
   std::string scalar_range;  // "MIN,MAX"; empty: the scalars' own range
   float line_width = 1.0f;
+  float lod_pixels = 4.0f;  // far-view LoD: fiblets projected smaller drawn as one segment (0: off)
   std::string background = "0,0,0";
 };
 

@@ -36,6 +36,7 @@
 #include "render/gpu_frame_renderer.h"
 #include "render/gpu_pick.h"
 #include "render/gpu_raw_tractogram.h"
+#include "render/gpu_upscale_pass.h"
 #include "render/orbit_controller.h"
 #include "render/reference_raster.h"
 
@@ -163,6 +164,15 @@ class ViewerApp {
   std::unique_ptr<ImGuiLayer> imgui_;
   std::unique_ptr<FrameRenderer> renderer_;
   std::unique_ptr<FrameRenderer> shot_renderer_;  // scene-only screenshots at a chosen size
+  // Coarse frames (adaptive detail) at half resolution, upscaled into
+  // renderer_'s colour buffer; both made at the first coarse frame.
+  std::unique_ptr<FrameRenderer> coarse_renderer_;
+  UpscalePass upscale_;
+  bool upscale_ready_ = false;
+  // The renderer that recorded the frame last submitted (its statistics and
+  // G-buffer; null for a background-only frame) and its pixel scale.
+  FrameRenderer* recorded_renderer_ = nullptr;
+  uint32_t drawn_scale_ = 1;
   std::vector<std::unique_ptr<ViewerModel>> scenes_;  // index-aligned with state_.models
   int framed_model_ = -1;  // the model the camera was last framed on
   std::unique_ptr<ViewerSelection> selection_;
@@ -275,6 +285,10 @@ void ViewerApp::release() {
   vkDeviceWaitIdle(context_->device());
   imgui_.reset();
   shot_renderer_.reset();
+  coarse_renderer_.reset();
+  recorded_renderer_ = nullptr;
+  if (upscale_ready_) destroyUpscalePass(*context_, upscale_);
+  upscale_ready_ = false;
   renderer_.reset();
   selection_.reset();
   scenes_.clear();
@@ -607,7 +621,9 @@ void ViewerApp::pickAt(const PickAction& pick) {
     // The G-buffer holds the last frame drawn: it answers for that model only.
     if (drawn_dataset_ && drawn_dataset_ == selection_->dataset() && pick.x < presentation_.width &&
         pick.y < presentation_.height)
-      result = pickFiber(*context_, renderer_->targets(), uint32_t(pick.x), uint32_t(pick.y));
+      // A coarse frame's G-buffer is the half-resolution one.
+      result = pickFiber(*context_, recorded_renderer_ ? recorded_renderer_->targets() : renderer_->targets(),
+                         uint32_t(pick.x) / drawn_scale_, uint32_t(pick.y) / drawn_scale_);
     selection_->pick(result, pick.add);
     syncSelection();
     const size_t n = selection_->size();
@@ -636,7 +652,7 @@ void ViewerApp::finishFrame() {
   state_.coarse_frame = submitted_coarse_;
   FrameRecord record;
   record.frame_ms = last_frame_ms_;
-  record.gpu = renderer_->collect();
+  record.gpu = (recorded_renderer_ ? recorded_renderer_ : renderer_.get())->collect();
   state_.addFrame(std::move(record));
 }
 
@@ -656,6 +672,7 @@ void ViewerApp::recordFrame(VkCommandBuffer cmd, uint32_t width, uint32_t height
   const ViewerModel* scene = activeScene();
   drawn_dataset_ = nullptr;
   frame_coarse_ = false;
+  recorded_renderer_ = nullptr;
   if (scene) {
     RenderSettings settings = drawSettings(*scene);
     // Adaptive detail (adaptive_detail.h). Moving: the camera differs from
@@ -667,7 +684,31 @@ void ViewerApp::recordFrame(VkCommandBuffer cmd, uint32_t width, uint32_t height
       settings = coarseSettings(settings, state_.moving_lod_px);
       frame_coarse_ = true;
     }
-    renderer_->record(cmd, camera, settings, withSelection(scene->gpuScene()));
+    if (frame_coarse_) {
+      // At half resolution (the coarse frame is bound by its pixels: long
+      // LoD segments), stretched over the window's colour buffer.
+      const uint32_t half_width = std::max(1u, width / 2), half_height = std::max(1u, height / 2);
+      if (!coarse_renderer_) coarse_renderer_ = std::make_unique<FrameRenderer>(*context_, half_width, half_height);
+      else if (coarse_renderer_->targets().width != half_width || coarse_renderer_->targets().height != half_height)
+        coarse_renderer_->resize(half_width, half_height);
+      if (!upscale_ready_) {
+        upscale_ = createUpscalePass(*context_);
+        upscale_ready_ = true;
+      }
+      Camera half = camera;
+      half.width = half_width;
+      half.height = half_height;
+      coarse_renderer_->record(cmd, half, settings, withSelection(scene->gpuScene()));
+      gpu::computeToComputeBarrier(cmd);
+      recordUpscale(cmd, upscale_, coarse_renderer_->targets().color, half_width, half_height,
+                    renderer_->targets().color, width, height);
+      recorded_renderer_ = coarse_renderer_.get();
+      drawn_scale_ = 2;
+    } else {
+      renderer_->record(cmd, camera, settings, withSelection(scene->gpuScene()));
+      recorded_renderer_ = renderer_.get();
+      drawn_scale_ = 1;
+    }
     drawn_dataset_ = &scene->fiblets;
   } else {
     // Nothing to draw: the background alone (RGBA8, R in the low byte).
