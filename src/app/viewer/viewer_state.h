@@ -108,6 +108,7 @@ struct ViewerState {
   bool show_models = true;
   bool show_selection = true;
   std::string screenshot_path = "fibscope.png";  // the screenshot button's file
+  std::string open_path;                         // the models panel's path entry
   int screenshot_width = 0, screenshot_height = 0;  // 0: the window as shown
 };
 

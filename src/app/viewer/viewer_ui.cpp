@@ -1,6 +1,7 @@
 #include "app/viewer/viewer_ui.h"
 
 #include <imgui.h>
+#include <imgui_stdlib.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -93,10 +94,8 @@ void settingsPanel(ViewerState& state, std::vector<ViewerAction>& actions) {
   if (ImGui::Button("Reset")) actions.push_back(ViewAction{});
 
   ImGui::Separator();
-  static char shot[1024] = "";
-  if (shot[0] == 0) std::snprintf(shot, sizeof(shot), "%s", state.screenshot_path.c_str());
   ImGui::SetNextItemWidth(-1);
-  if (ImGui::InputText("##shot", shot, sizeof(shot))) state.screenshot_path = shot;
+  ImGui::InputText("##shot", &state.screenshot_path);
   int size[2] = {state.screenshot_width, state.screenshot_height};
   if (ImGui::InputInt2("size (0: window)", size)) {
     state.screenshot_width = std::clamp(size[0], 0, 16384);

@@ -4,6 +4,7 @@
 // other panels it edits ViewerState (visibility, the active model, dismissed
 // failures) and asks for the rest (open, close) through actions.
 #include <imgui.h>
+#include <imgui_stdlib.h>
 
 #include <algorithm>
 #include <cmath>
@@ -132,12 +133,11 @@ void modelList(ViewerState& state, std::vector<ViewerAction>& actions) {
 }
 
 void openSection(ViewerState& state, std::vector<ViewerAction>& actions) {
-  static char path[1024] = "";
   ImGui::SetNextItemWidth(-60);
-  const bool enter = ImGui::InputTextWithHint("##path", "file.tck / .trk / .trx / .vtk / .fbl", path, sizeof(path),
+  const bool enter = ImGui::InputTextWithHint("##path", "file.tck / .trk / .trx / .vtk / .fbl", &state.open_path,
                                               ImGuiInputTextFlags_EnterReturnsTrue);
   ImGui::SameLine();
-  if ((ImGui::Button("Open") || enter) && path[0] != 0) actions.push_back(OpenAction{path});
+  if ((ImGui::Button("Open") || enter) && !state.open_path.empty()) actions.push_back(OpenAction{state.open_path});
   if (state.recent_files.empty()) return;
   ImGui::SetNextItemWidth(-60);
   if (ImGui::BeginCombo("##recent", "recent files")) {

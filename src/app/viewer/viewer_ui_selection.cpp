@@ -2,6 +2,7 @@
 // fibers' lengths, clearing, export to .tck and how the selection is shown.
 // Appears while something is selected (the Window menu hides it).
 #include <imgui.h>
+#include <imgui_stdlib.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -59,10 +60,8 @@ void drawSelectionPanel(ViewerState& state, std::vector<ViewerAction>& actions) 
   }
 
   ImGui::Separator();
-  static char path[1024] = "";
-  if (path[0] == 0) std::snprintf(path, sizeof(path), "%s", selection.export_path.c_str());
   ImGui::SetNextItemWidth(-1);
-  if (ImGui::InputTextWithHint("##export", "selection.tck", path, sizeof(path))) selection.export_path = path;
+  ImGui::InputTextWithHint("##export", "selection.tck", &selection.export_path);
   if (!selection.exportable) ImGui::BeginDisabled();
   if (ImGui::Button("Export .tck") && !selection.export_path.empty())
     actions.push_back(ExportSelectionAction{selection.export_path});
