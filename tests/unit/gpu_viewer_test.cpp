@@ -71,7 +71,9 @@ TEST(ViewerScript, malformedLinesNameTheFileAndLine) {
   for (const std::string bad :
        {"orbit 1", "orbit a b", "pan 1 2 3", "dolly", "view top", "fov 5", "fov 120", "set color red",
         "set width 9", "set ssao maybe", "set background 2,0,0", "set speed 3", "wait 0", "wait 1.5",
-        "screenshot out.jpg", "screenshot out.png 0x5", "quit now", "jump 3", "orbit nan 1"}) {
+        "screenshot out.jpg", "screenshot out.png 0x5", "quit now", "jump 3", "orbit nan 1", "resize 400",
+        "resize 8 8", "resize 400.5 300", "resize 20000 300", "set ao-scales 5", "set colormap jet",
+        "set scalar-range 5,1", "set fxaa maybe", "set dim 2"}) {
     SCOPED_TRACE(bad);
     try {
       parseScript("view axial\n# fine\n" + bad + "\nquit\n", "session.txt");
@@ -440,6 +442,43 @@ TEST_F(GpuViewer, scriptedSessionRunsCleanUnderValidation) {
   const Png shown = readOurPng(shown_png);
   EXPECT_EQ(shown.width, 320u);
   EXPECT_GT(menuBarShare(shown), 0.8);
+}
+
+// A resize mid-run: the frame targets, the presentation image and (in a
+// window) the swapchain are made again; the screenshots have the new sizes
+// and still show the scene, with no validation message.
+void expectResizedRun(const test::CommandResult& r, const std::string& middle, const std::string& last) {
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Png m = readOurPng(middle), l = readOurPng(last);
+  EXPECT_EQ(m.width, 400u);
+  EXPECT_EQ(m.height, 300u);
+  EXPECT_GT(coverage(m, 200, 150, 400, 300), 0.02) << "the scene after the first resize";
+  EXPECT_EQ(l.width, 360u);
+  EXPECT_EQ(l.height, 240u);
+  EXPECT_GT(coverage(l, 180, 120, 360, 240), 0.02) << "the scene after the second resize";
+}
+
+std::string resizeScript(test::TempDir& dir, const std::string& middle) {
+  const std::string script = dir.file("resize.txt");
+  test::writeBytes(script, "wait-loaded\nwait 2\nresize 400 300\nwait 3\nscreenshot " + middle +
+                               "\nresize 360 240\nwait 3\nquit\n");
+  return script;
+}
+
+TEST_F(GpuViewer, offscreenResizeRemakesTheTargets) {
+  const std::string middle = dir_.file("middle.png"), last = dir_.file("last.png");
+  const auto r =
+      runViewer("--offscreen --size 320x200 --script " + resizeScript(dir_, middle) + " --screenshot " + last);
+  expectResizedRun(r, middle, last);
+}
+
+TEST_F(GpuViewer, windowResizeUnderXvfbRemakesTheSwapchain) {
+  if (test::runCommand("command -v xvfb-run").exit_code != 0) GTEST_SKIP() << "xvfb-run is not installed";
+  const std::string middle = dir_.file("middle.png"), last = dir_.file("last.png");
+  const auto r = runViewer("--size 320x200 --script " + resizeScript(dir_, middle) + " --screenshot " + last,
+                           "xvfb-run -a -s '-screen 0 640x480x24' env ");
+  EXPECT_EQ(r.output.find("offscreen"), std::string::npos) << "no window was made: " << r.output;
+  expectResizedRun(r, middle, last);
 }
 
 TEST_F(GpuViewer, malformedScriptLineIsAOneLineErrorWithItsLineNumber) {

@@ -62,11 +62,14 @@ struct ExpectSelectedAction {
   uint64_t count = 0;
   std::string where;  // "SCRIPT:LINE"
 };
+struct ResizeAction {  // the window (or the offscreen image) to this size in pixels
+  uint32_t width = 0, height = 0;
+};
 struct QuitAction {};
 
 using ViewerAction = std::variant<OrbitAction, PanAction, DollyAction, ViewAction, FovAction, SetAction,
                                   ScreenshotAction, OpenAction, CloseModelAction, PickAction, ClearSelectionAction,
-                                  ExportSelectionAction, ExpectSelectedAction, QuitAction>;
+                                  ExportSelectionAction, ExpectSelectedAction, ResizeAction, QuitAction>;
 
 // Sets one RenderSettings field from text, as `set KEY VALUE` in a script:
 //   pipeline compute|lines|raw-compute, culling none|frustum|two-phase,

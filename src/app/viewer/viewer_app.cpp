@@ -522,6 +522,12 @@ void ViewerApp::apply(const ViewerAction& action) {
         } else if constexpr (std::is_same_v<A, ViewAction>) {
           if (a.view) controller_.setStandardView(*a.view);
           else controller_.reset();
+        } else if constexpr (std::is_same_v<A, ResizeAction>) {
+          // The frame loop follows the framebuffer (window) or these sizes
+          // (offscreen) and recreates the targets and swapchain.
+          if (window_) window_->setSize(a.width, a.height);
+          options_.width = a.width;
+          options_.height = a.height;
         } else if constexpr (std::is_same_v<A, FovAction>) {
           controller_.setFovY(a.degrees);
           state_.fov_deg = controller_.fovY();

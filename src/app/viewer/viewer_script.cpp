@@ -116,13 +116,21 @@ std::variant<ViewerAction, WaitFrames, WaitLoaded> parseCommand(const std::vecto
       throw Error("expect-selected: expected a fiber count, got " + std::string(w[1]));
     return ViewerAction{ExpectSelectedAction{uint64_t(n), {}}};
   }
+  if (name == "resize") {
+    expectArguments(w, 2, 2, "resize WIDTH HEIGHT");
+    const double width = number(w[1], "WIDTH"), height = number(w[2], "HEIGHT");
+    if (!(width >= 16 && width <= 16384 && height >= 16 && height <= 16384) || width != std::floor(width) ||
+        height != std::floor(height))
+      throw Error("resize: expected 16 to 16384 pixels each, got " + std::string(w[1]) + " x " + std::string(w[2]));
+    return ViewerAction{ResizeAction{uint32_t(width), uint32_t(height)}};
+  }
   if (name == "quit") {
     expectArguments(w, 0, 0, "quit");
     return ViewerAction{QuitAction{}};
   }
   throw Error("unknown command '" + std::string(name) +
               "' (expected orbit, pan, dolly, view, fov, set, wait, wait-loaded, open, screenshot, pick, "
-              "clear-selection, export-selection, expect-selected or quit)");
+              "clear-selection, export-selection, expect-selected, resize or quit)");
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 //   clear-selection
 //   export-selection OUT.tck    (the selected fibers of the active model)
 //   expect-selected N           (the run fails naming the line unless N are selected)
+//   resize W H                 (the window, or the offscreen image, in pixels)
 //   quit
 #pragma once
 

@@ -74,6 +74,8 @@ void ViewerWindow::pollEvents() { glfwPollEvents(); }
 void ViewerWindow::waitEvents() { glfwWaitEventsTimeout(0.1); }
 bool ViewerWindow::shouldClose() const { return glfwWindowShouldClose(window_); }
 
+void ViewerWindow::setSize(uint32_t width, uint32_t height) { glfwSetWindowSize(window_, int(width), int(height)); }
+
 void ViewerWindow::framebufferSize(uint32_t& width, uint32_t& height) const {
   int w = 0, h = 0;
   glfwGetFramebufferSize(window_, &w, &h);

@@ -39,6 +39,9 @@ class ViewerWindow {
   // Blocks until an event comes (a minimised window draws nothing).
   void waitEvents();
   bool shouldClose() const;
+  // Asks for a window of width x height screen coordinates (the framebuffer
+  // follows once the window system has applied it).
+  void setSize(uint32_t width, uint32_t height);
   // The framebuffer's size in pixels (0 x 0 while minimised).
   void framebufferSize(uint32_t& width, uint32_t& height) const;
   // The events queued since the last call, in order.
