@@ -11,6 +11,10 @@
 #include <random>
 #include <sstream>
 
+#include "io/reader.h"
+#include "io/writer.h"
+#include "phantom/phantom.h"
+
 namespace fibscope::test {
 
 TempDir::TempDir() {
@@ -88,6 +92,19 @@ Tractogram smallTractogram(size_t streamlines, unsigned seed, bool with_data) {
     if (with_data) t.per_streamline[0].values.push_back(float(s) * 0.25f);
   }
   return t;
+}
+
+std::string writePhantomTck(const TempDir& dir, const std::string& name, uint64_t streamlines, uint64_t seed) {
+  PhantomOptions options;
+  options.streamlines = streamlines;
+  options.seed = seed;
+  options.threads = 1;
+  auto reader = openPhantom(options);
+  Tractogram all = readAllStreamlines(*reader);
+  all.per_streamline.clear();
+  const std::string path = dir.file(name);
+  writeTractogram(path, all, TractogramHeader{});
+  return path;
 }
 
 }  // namespace fibscope::test

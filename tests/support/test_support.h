@@ -44,4 +44,8 @@ std::string readBytes(const std::string& path);
 // points in a 100 mm box, with optional data arrays.
 Tractogram smallTractogram(size_t streamlines, unsigned seed = 1, bool with_data = false);
 
+// The built-in phantom's first `streamlines` fibers (one thread, `seed`)
+// written as dir/name in .tck, without per-streamline data; returns the path.
+std::string writePhantomTck(const TempDir& dir, const std::string& name, uint64_t streamlines, uint64_t seed);
+
 }  // namespace fibscope::test

@@ -24,16 +24,7 @@ using test::TempDir;
 
 // A phantom .tck of a few MB, so that most of it lies outside the sampled blocks.
 std::string writePhantomTck(const TempDir& dir, const std::string& name, uint64_t streamlines = 300) {
-  PhantomOptions options;
-  options.streamlines = streamlines;
-  options.seed = 3;
-  options.threads = 1;
-  auto reader = openPhantom(options);
-  Tractogram all = readAllStreamlines(*reader);
-  all.per_streamline.clear();
-  const std::string path = dir.file(name);
-  writeTractogram(path, all, TractogramHeader{});
-  return path;
+  return test::writePhantomTck(dir, name, streamlines, 3);
 }
 
 struct stat statOf(const std::string& path) {

@@ -236,20 +236,10 @@ TEST_F(GpuBaselines, linesCoverTheCpuReferenceToAboutAPixel) {
 TEST_F(GpuBaselines, uploadFillsEveryTableThroughASmallStagingBuffer) {
   // Streamlines of 0, 1, 2 and many points, ends at word boundaries and
   // inside words.
-  Tractogram t;
-  std::vector<float> xyz;
-  const size_t lengths[] = {5, 0, 1, 31, 2, 40, 0, 64, 1, 3};
+  const std::initializer_list<size_t> lengths = {5, 0, 1, 31, 2, 40, 0, 64, 1, 3};
+  const Tractogram t = test::lineTractogram(lengths);
   uint64_t expected_segments = 0;
-  for (size_t n : lengths) {
-    xyz.clear();
-    for (size_t i = 0; i < n; ++i) {
-      xyz.push_back(float(t.pointCount() + i));
-      xyz.push_back(0.5f * float(i));
-      xyz.push_back(-1.0f);
-    }
-    t.addStreamline(xyz.data(), n);
-    expected_segments += n > 0 ? n - 1 : 0;
-  }
+  for (size_t n : lengths) expected_segments += n > 0 ? n - 1 : 0;
   const GpuRawTractogram raw = GpuRawTractogram::upload(context(), t, "small", nullptr, nullptr, 48);
   EXPECT_EQ(raw.streamlineCount(), std::size(lengths));
   EXPECT_EQ(raw.pointCount(), t.pointCount());

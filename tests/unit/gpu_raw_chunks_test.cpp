@@ -28,22 +28,7 @@ namespace {
 using test::gbufferMask;
 using test::renderPhantom;
 
-// Streamlines of the given point counts along x, point k of the whole
-// tractogram at (k, 0.5 * its index in the streamline, -1).
-Tractogram lineTractogram(std::initializer_list<size_t> lengths) {
-  Tractogram t;
-  std::vector<float> xyz;
-  for (size_t n : lengths) {
-    xyz.clear();
-    for (size_t i = 0; i < n; ++i) {
-      xyz.push_back(float(t.pointCount() + i));
-      xyz.push_back(0.5f * float(i));
-      xyz.push_back(-1.0f);
-    }
-    t.addStreamline(xyz.data(), n);
-  }
-  return t;
-}
+using test::lineTractogram;
 
 bool sameTexels(const std::vector<shader::GBufferTexel>& a, const std::vector<shader::GBufferTexel>& b) {
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(shader::GBufferTexel)) == 0;

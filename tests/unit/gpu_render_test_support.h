@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <initializer_list>
 #include <vector>
 
 #include "core/tractogram.h"
@@ -18,6 +19,24 @@ namespace fibscope::test {
 
 // A brain-like phantom at 0.1 mm steps, generated on one thread
 // (deterministic for the seed).
+// Streamlines of the given point counts along x: point k of the whole
+// tractogram at (k, 0.5 * its index in the streamline, -1). Empty and
+// one-point streamlines included, for tests of tables and chunks.
+inline Tractogram lineTractogram(std::initializer_list<size_t> lengths) {
+  Tractogram t;
+  std::vector<float> xyz;
+  for (size_t n : lengths) {
+    xyz.clear();
+    for (size_t i = 0; i < n; ++i) {
+      xyz.push_back(float(t.pointCount() + i));
+      xyz.push_back(0.5f * float(i));
+      xyz.push_back(-1.0f);
+    }
+    t.addStreamline(xyz.data(), n);
+  }
+  return t;
+}
+
 inline Tractogram renderPhantom(uint64_t streamlines, uint64_t seed) {
   PhantomOptions options;
   options.streamlines = streamlines;

@@ -20,16 +20,7 @@ namespace {
 using test::TempDir;
 
 std::string writePhantomTck(const TempDir& dir, const std::string& name, uint64_t streamlines) {
-  PhantomOptions options;
-  options.streamlines = streamlines;
-  options.seed = 5;
-  options.threads = 1;
-  auto reader = openPhantom(options);
-  Tractogram all = readAllStreamlines(*reader);
-  all.per_streamline.clear();
-  const std::string path = dir.file(name);
-  writeTractogram(path, all, TractogramHeader{});
-  return path;
+  return test::writePhantomTck(dir, name, streamlines, 5);
 }
 
 ModelLoaderOptions optionsIn(const TempDir& dir) {
