@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "render/colormap.h"
 
 namespace fibscope {
 
@@ -91,16 +92,7 @@ void applyScalarColoring(const gpu::VulkanContext& context, const GpuDataset& da
   if (!o.scalar_range.empty()) return;
   std::vector<float> lengths(fibers);
   gpu::downloadFromBuffer(context, dataset.fiberLength(), lengths.data(), lengths.size() * sizeof(float));
-  // Finite lengths only: a damaged table must not make the range NaN.
-  float lo = INFINITY, hi = -INFINITY;
-  for (float v : lengths)
-    if (std::isfinite(v)) {
-      lo = std::min(lo, v);
-      hi = std::max(hi, v);
-    }
-  if (lo > hi) return;  // none finite: the default range stays
-  settings.scalar_min = lo;
-  settings.scalar_max = hi;
+  finiteRange(lengths, settings.scalar_min, settings.scalar_max);  // none finite: the default range stays
 }
 
 std::unique_ptr<gpu::VulkanContext> createRenderContext(const RenderCliOptions& o) {

@@ -77,4 +77,17 @@ uint32_t colormapIndex(float value, float scalar_min, float scalar_max) {
   return uint32_t(t * float(kColormapEntries - 1) + 0.5f);
 }
 
+bool finiteRange(std::span<const float> values, float& lo, float& hi) {
+  float low = INFINITY, high = -INFINITY;
+  for (float v : values)
+    if (std::isfinite(v)) {
+      low = std::min(low, v);
+      high = std::max(high, v);
+    }
+  if (low > high) return false;
+  lo = low;
+  hi = high;
+  return true;
+}
+
 }  // namespace fibscope

@@ -42,4 +42,10 @@ std::vector<uint32_t> allColormapTables();
 // middle), entry round(t * 255). shade.comp does the same arithmetic.
 uint32_t colormapIndex(float value, float scalar_min, float scalar_max);
 
+// The range of the finite values of a per-fiber scalar (ColorMode::Scalar's
+// default range): false, leaving lo and hi alone, when none is finite. NaN
+// and infinities are skipped so that a damaged table cannot make the range
+// NaN.
+bool finiteRange(std::span<const float> values, float& lo, float& hi);
+
 }  // namespace fibscope

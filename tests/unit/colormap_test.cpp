@@ -72,3 +72,23 @@ TEST(Colormap, indexClampsTheRangeAndHandlesDegenerateInput) {
 
 }  // namespace
 }  // namespace fibscope
+
+namespace fibscope {
+namespace {
+
+TEST(Colormap, finiteRangeSkipsNanAndInfinitiesAndLeavesTheRangeWhenNoneIsFinite) {
+  float lo = -7, hi = 7;
+  const std::vector<float> lengths = {NAN, 42.5f, INFINITY, 20.0f, -INFINITY, 250.0f};
+  EXPECT_TRUE(finiteRange(lengths, lo, hi));
+  EXPECT_EQ(lo, 20.0f);
+  EXPECT_EQ(hi, 250.0f);
+  lo = -7, hi = 7;
+  const std::vector<float> damaged = {NAN, INFINITY};
+  EXPECT_FALSE(finiteRange(damaged, lo, hi));
+  EXPECT_EQ(lo, -7.0f);
+  EXPECT_EQ(hi, 7.0f);
+  EXPECT_FALSE(finiteRange({}, lo, hi));
+}
+
+}  // namespace
+}  // namespace fibscope
