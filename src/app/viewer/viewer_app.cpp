@@ -34,6 +34,7 @@
 #include "phantom/phantom.h"
 #include "render/gpu_dataset.h"
 #include "render/gpu_frame_renderer.h"
+#include "render/colormap.h"
 #include "render/gpu_pick.h"
 #include "render/gpu_raw_tractogram.h"
 #include "render/gpu_upscale_pass.h"
@@ -170,9 +171,8 @@ class ViewerApp {
   UpscalePass upscale_;
   bool upscale_ready_ = false;
   // The renderer that recorded the frame last submitted (its statistics and
-  // G-buffer; null for a background-only frame) and its pixel scale.
+  // G-buffer; null for a background-only frame).
   FrameRenderer* recorded_renderer_ = nullptr;
-  uint32_t drawn_scale_ = 1;
   std::vector<std::unique_ptr<ViewerModel>> scenes_;  // index-aligned with state_.models
   int framed_model_ = -1;  // the model the camera was last framed on
   std::unique_ptr<ViewerSelection> selection_;
@@ -427,16 +427,11 @@ void ViewerApp::frameActiveModel() {
   controller_.frame(data.bounds, data.sample);
   framed_model_ = state_.active_model;
   // The scalar colour mode's range follows the model shown: its fibers'
-  // lengths (finite ones: a damaged table must not make the range NaN).
+  // lengths.
   state_.scalar_data_min = 1, state_.scalar_data_max = 0;
   if (const FblSection* section = data.fbl.find(kFblSectionFiberLength)) {
     try {
-      for (float v : data.fbl.array<float>(*section))
-        if (std::isfinite(v)) {
-          if (state_.scalar_data_min > state_.scalar_data_max) state_.scalar_data_min = state_.scalar_data_max = v;
-          state_.scalar_data_min = std::min(state_.scalar_data_min, v);
-          state_.scalar_data_max = std::max(state_.scalar_data_max, v);
-        }
+      finiteRange(data.fbl.array<float>(*section), state_.scalar_data_min, state_.scalar_data_max);
     } catch (const Error& e) {
       state_.status = e.what();
     }
@@ -625,11 +620,14 @@ void ViewerApp::pickAt(const PickAction& pick) {
     finishFrame();
     PickResult result;  // no hit
     // The G-buffer holds the last frame drawn: it answers for that model only.
-    if (drawn_dataset_ && drawn_dataset_ == selection_->dataset() && pick.x < presentation_.width &&
-        pick.y < presentation_.height)
-      // A coarse frame's G-buffer is the half-resolution one.
-      result = pickFiber(*context_, recorded_renderer_ ? recorded_renderer_->targets() : renderer_->targets(),
-                         uint32_t(pick.x) / drawn_scale_, uint32_t(pick.y) / drawn_scale_);
+    if (drawn_dataset_ && drawn_dataset_ == selection_->dataset() && pick.x >= 0 && pick.y >= 0 &&
+        pick.x < presentation_.width && pick.y < presentation_.height) {
+      // The G-buffer of the renderer that drew it (a coarse frame's is
+      // smaller): window pixels scaled to its size.
+      const GpuFrameTargets& drawn = (recorded_renderer_ ? recorded_renderer_ : renderer_.get())->targets();
+      result = pickFiber(*context_, drawn, uint32_t(uint64_t(pick.x) * drawn.width / presentation_.width),
+                         uint32_t(uint64_t(pick.y) * drawn.height / presentation_.height));
+    }
     selection_->pick(result, pick.add);
     syncSelection();
     const size_t n = selection_->size();
@@ -709,11 +707,9 @@ void ViewerApp::recordFrame(VkCommandBuffer cmd, uint32_t width, uint32_t height
       recordUpscale(cmd, upscale_, coarse_renderer_->targets().color, half_width, half_height,
                     renderer_->targets().color, width, height);
       recorded_renderer_ = coarse_renderer_.get();
-      drawn_scale_ = 2;
     } else {
       renderer_->record(cmd, camera, settings, withSelection(scene->gpuScene()));
       recorded_renderer_ = renderer_.get();
-      drawn_scale_ = 1;
     }
     drawn_dataset_ = &scene->fiblets;
   } else {
