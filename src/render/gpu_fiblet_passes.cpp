@@ -21,6 +21,10 @@ bool subgroupScanFits(const gpu::DeviceInfo& info, uint32_t lanes) {
 }  // namespace
 
 uint32_t defaultRasterLanes(const gpu::VulkanContext& context) {
+  // CPU devices: one invocation per fiblet, decoded serially
+  // (fiblet_raster_serial.comp). lavapipe, the 246 MB tckgen file at 1080p:
+  // see docs/BENCHMARKS.md for the serial decode against the 8-lane scan.
+  if (context.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU) return 1;
   // 8 lanes (8 points each) wherever subgroup shuffles can scan them: the
   // fewest compositions per point. On an H100 (32-wide subgroups, 500 k
   // fibers, 1080p) the raster took 14.8 ms with 8 lanes and four fiblets per
@@ -34,9 +38,12 @@ uint32_t defaultRasterLanes(const gpu::VulkanContext& context) {
 
 FibletPasses createFibletPasses(const gpu::VulkanContext& context, uint32_t raster_lanes, RasterScan scan) {
   if (raster_lanes == 0) raster_lanes = defaultRasterLanes(context);
-  if (raster_lanes != 8 && raster_lanes != 16 && raster_lanes != 32 && raster_lanes != 64)
-    throw Error("fiblet raster: lanes per fiblet must be 8, 16, 32 or 64, got " + std::to_string(raster_lanes));
-  const bool subgroup_ok = subgroupScanFits(context.info(), raster_lanes);
+  if (raster_lanes != 1 && raster_lanes != 8 && raster_lanes != 16 && raster_lanes != 32 && raster_lanes != 64)
+    throw Error("fiblet raster: lanes per fiblet must be 1, 8, 16, 32 or 64, got " + std::to_string(raster_lanes));
+  const bool serial = raster_lanes == 1;
+  if (serial && scan != RasterScan::Auto)
+    throw Error("fiblet raster: one lane per fiblet decodes serially; it has no scan to choose");
+  const bool subgroup_ok = !serial && subgroupScanFits(context.info(), raster_lanes);
   if (scan == RasterScan::Subgroup && !subgroup_ok)
     throw Error("fiblet raster: a subgroup scan of " + std::to_string(raster_lanes) +
                 " lanes needs subgroups a multiple of that wide with relative shuffles; " + context.info().name +
@@ -53,15 +60,22 @@ FibletPasses createFibletPasses(const gpu::VulkanContext& context, uint32_t rast
     // subgroups per workgroup measured 7-11 % slower), else the paper's one
     // workgroup per fiblet.
     const uint32_t subgroup = context.info().subgroup_size;
-    if (context.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU)
+    if (serial) {
+      passes.raster_fiblets_per_group = std::max<uint32_t>(64, subgroup);
+      const uint32_t specialization[] = {passes.raster_fiblets_per_group};
+      passes.raster = gpu::createComputePipeline(context, "fiblet_raster_serial.comp",
+                                                 sizeof(shader::FibletRasterPush), specialization);
+    } else if (context.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU)
       passes.raster_fiblets_per_group = std::max<uint32_t>(64, subgroup) / raster_lanes;
     else
       passes.raster_fiblets_per_group = passes.raster_subgroup_scan ? subgroup / raster_lanes : 1;
-    const uint32_t specialization[] = {raster_lanes, passes.raster_fiblets_per_group,
-                                       raster_lanes * passes.raster_fiblets_per_group};
-    passes.raster = gpu::createComputePipeline(
-        context, passes.raster_subgroup_scan ? "fiblet_raster_subgroup.comp" : "fiblet_raster.comp",
-        sizeof(shader::FibletRasterPush), specialization);
+    if (!serial) {
+      const uint32_t specialization[] = {raster_lanes, passes.raster_fiblets_per_group,
+                                         raster_lanes * passes.raster_fiblets_per_group};
+      passes.raster = gpu::createComputePipeline(
+          context, passes.raster_subgroup_scan ? "fiblet_raster_subgroup.comp" : "fiblet_raster.comp",
+          sizeof(shader::FibletRasterPush), specialization);
+    }
     passes.resolve = gpu::createComputePipeline(context, "fiblet_resolve.comp", sizeof(shader::FibletResolvePush));
   } catch (...) {
     destroyFibletPasses(context, passes);
