@@ -6,7 +6,9 @@
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
+#include <future>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "app/commands.h"
@@ -64,29 +66,48 @@ void runRender(const RenderCommandOptions& o) {
   uint32_t width = 0, height = 0;
   parseFrameSize(o.render.size, width, height);
 
-  auto context = createRenderContext(o.render);
+  // The instance, the device and the frame renderer's pipelines (lavapipe
+  // compiles every shader with LLVM here) take ~0.15 s on one core: made on
+  // a second thread during the first pass over the file, which reads on
+  // one core. loadScene waits for them only when it uploads.
+  struct Device {
+    std::unique_ptr<gpu::VulkanContext> context;
+    std::unique_ptr<FrameRenderer> renderer;  // destroyed before the context
+  };
+  std::future<Device> making = std::async(std::launch::async, [&o, width, height] {
+    Device d;
+    d.context = createRenderContext(o.render);
+    d.renderer = std::make_unique<FrameRenderer>(*d.context, width, height);
+    return d;
+  });
+  std::optional<Device> device;
+  auto waitForDevice = [&]() -> const gpu::VulkanContext& {
+    if (!device) device = making.get();
+    return *device->context;
+  };
   SceneOptions scene_options;
   scene_options.path = o.render.input;
   scene_options.phantom_streamlines = o.render.phantom_streamlines;
   scene_options.upload_raw = settings.pipeline != RenderPipeline::Compute;
-  LoadedScene scene = loadScene(*context, scene_options);
+  LoadedScene scene = loadScene(waitForDevice, scene_options);
+  const gpu::VulkanContext& context = waitForDevice();
 
   GpuScene gpu_scene = scene.gpuScene();
-  applyScalarColoring(*context, scene.fiblets, o.render, settings, gpu_scene);
+  applyScalarColoring(context, scene.fiblets, o.render, settings, gpu_scene);
   const Camera camera = cameraFor(o, scene, width, height);
   auto t = Clock::now();
   FrameStats stats;
   std::vector<uint8_t> rgba;
   {
-    FrameRenderer renderer(*context, width, height);
+    FrameRenderer& renderer = *device->renderer;
     stats = renderer.render(camera, settings, gpu_scene);
-    rgba = downloadColor(*context, renderer.targets());
+    rgba = downloadColor(context, renderer.targets());
   }
   const double frame_seconds = secondsSince(t);
   t = Clock::now();
   writePngRgba(o.output, width, height, rgba);
   const double png_seconds = secondsSince(t);
-  checkValidation(*context, o.render);
+  checkValidation(context, o.render);
   std::printf("%s: %llu streamlines, %llu segments -> %s (%ux%u, %s pipeline, %s culling)\n", scene.name.c_str(),
               static_cast<unsigned long long>(scene.streamlines), static_cast<unsigned long long>(scene.segments),
               o.output.c_str(), width, height, std::string(renderPipelineName(settings.pipeline)).c_str(),

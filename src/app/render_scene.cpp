@@ -24,6 +24,10 @@ uint64_t segmentCount(const Tractogram& t) {
 }  // namespace
 
 LoadedScene loadScene(const gpu::VulkanContext& context, const SceneOptions& options) {
+  return loadScene([&]() -> const gpu::VulkanContext& { return context; }, options);
+}
+
+LoadedScene loadScene(const ContextSource& device, const SceneOptions& options) {
   LoadedScene scene;
   scene.name = options.path.empty() ? "phantom" : options.path;
   PhantomOptions phantom;
@@ -38,7 +42,7 @@ LoadedScene loadScene(const gpu::VulkanContext& context, const SceneOptions& opt
   if (!fbl && !options.upload_raw) {
     // The compute pipeline alone: stream the input twice (estimate, then
     // encode chunks as they are read); the points are never all in memory.
-    StreamedUpload streamed = uploadStreamed(context, open, scene.name);
+    StreamedUpload streamed = uploadStreamed(device, open, scene.name);
     printWarnings(streamed.warnings);
     if (streamed.streamlines == 0) throw Error(scene.name + ": no streamlines to render");
     scene.fiblets = std::move(streamed.upload.dataset);
@@ -66,19 +70,20 @@ LoadedScene loadScene(const gpu::VulkanContext& context, const SceneOptions& opt
   if (fbl) {
     // Already fiblets: upload the records as stored (the decode above gave
     // the box and, for the baselines, the points).
-    t0 = Clock::now();
     const FblFile file = FblFile::open(options.path);
+    const gpu::VulkanContext& context = device();
+    t0 = Clock::now();
     scene.fiblets = GpuDataset::upload(context, file);
     scene.upload_seconds = secondsSince(t0);
   } else {
-    TractogramUpload upload = uploadTractogram(context, points, scene.name);
+    TractogramUpload upload = uploadTractogram(device(), points, scene.name);
     scene.fiblets = std::move(upload.dataset);
     scene.encode_seconds = upload.encode_seconds;
     scene.upload_seconds = upload.upload_seconds;
   }
   if (options.upload_raw) {
     t0 = Clock::now();
-    scene.raw = GpuRawTractogram::upload(context, points, scene.name);
+    scene.raw = GpuRawTractogram::upload(device(), points, scene.name);
     scene.has_raw = true;
     scene.upload_seconds += secondsSince(t0);
   }

@@ -14,6 +14,7 @@
 #include "render/gpu_dataset.h"
 #include "render/gpu_frame_renderer.h"
 #include "render/gpu_raw_tractogram.h"
+#include "render/gpu_tractogram_upload.h"
 
 namespace fibscope {
 
@@ -41,5 +42,9 @@ struct LoadedScene {
 // Reads, encodes and uploads. Throws Error naming the file for unreadable or
 // malformed input, and for a dataset that does not fit on the device.
 LoadedScene loadScene(const gpu::VulkanContext& context, const SceneOptions& options);
+// The same with the device made meanwhile (see ContextSource in
+// render/gpu_tractogram_upload.h): `context` is called when an upload
+// starts, after the reading and encoding.
+LoadedScene loadScene(const ContextSource& context, const SceneOptions& options);
 
 }  // namespace fibscope

@@ -51,6 +51,15 @@ StreamedUpload uploadStreamed(const gpu::VulkanContext& context,
                               const std::function<std::unique_ptr<TractogramReader>()>& open,
                               const std::string& name, Progress* progress = nullptr);
 
+// The device is needed only once the input is read and encoded: a caller
+// that creates it meanwhile on another thread (`render`: instance, device
+// and pipelines are made during the first pass over the file) passes a
+// function that waits for it; it is called right before each upload.
+using ContextSource = std::function<const gpu::VulkanContext&()>;
+StreamedUpload uploadStreamed(const ContextSource& context,
+                              const std::function<std::unique_ptr<TractogramReader>()>& open,
+                              const std::string& name, Progress* progress = nullptr);
+
 // Arc length of every streamline, mm.
 std::vector<float> streamlineLengths(const Tractogram& tractogram);
 
