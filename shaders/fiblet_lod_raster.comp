@@ -43,7 +43,7 @@ void main() {
   }
   const CameraBlock cam = CameraRef(pc.camera).camera;
   rasterSegment(VisibilityRef(pc.visibility), cam, fibletToWorld(ds, a), fibletToWorld(ds, b),
-                uint64_t(fiblet) << kKeySegmentBits);
+                uint64_t(pc.fiblet_base + fiblet) << kKeySegmentBits);
   // Its pixels resolve as segment 0: give that entry this segment's tangent.
-  if (pc.tangents != 0ul) UintsOutRef(pc.tangents).values[fiblet * 64u] = packSegmentTangent(b - a);
+  if (pc.tangents != 0ul) UintsOutRef(pc.tangents).values[(pc.fiblet_base + fiblet) * 64u] = packSegmentTangent(b - a);
 }

@@ -53,7 +53,9 @@ void main() {
   VisibilityRef vis = VisibilityRef(pc.visibility);
   const bool cache = pc.tangents != 0ul;
   UintsOutRef tangents = UintsOutRef(pc.tangents);
-  const uint64_t fiblet_key = uint64_t(fiblet) << kKeySegmentBits;
+  // Scene-global fiblet (shared/scene_table.h) for the key and the cache.
+  const uint global = pc.fiblet_base + fiblet;
+  const uint64_t fiblet_key = uint64_t(global) << kKeySegmentBits;
   vec3 a_world = fibletToWorld(ds, p0);
   vec4 a = cameraTransformPoint(cam.view_projection, a_world);
   // Transform k gives point k + 1: W_1 for k = 0, then L_{k+1}.
@@ -64,13 +66,13 @@ void main() {
     const vec3 b_world = fibletToWorld(ds, s.t);
     const vec4 b = cameraTransformPoint(cam.view_projection, b_world);
     rasterClipSegment(vis, cam, a, b, fiblet_key | uint64_t(k));
-    if (cache) tangents.values[fiblet * 64u + k] = packSegmentTangent(b_world - a_world);
+    if (cache) tangents.values[global * 64u + k] = packSegmentTangent(b_world - a_world);
     a = b;
     a_world = b_world;
   }
   if ((flags & kFibletFlagEnds) == 0u && fiblet + 1u < ds.fiblet_count) {
     const vec3 b = fibletToWorld(ds, fibletFirstPoint(records, base + ds.record_words));
     rasterClipSegment(vis, cam, a, cameraTransformPoint(cam.view_projection, b), fiblet_key | uint64_t(used));
-    if (cache) tangents.values[fiblet * 64u + used] = packSegmentTangent(b - a_world);
+    if (cache) tangents.values[global * 64u + used] = packSegmentTangent(b - a_world);
   }
 }

@@ -1,6 +1,8 @@
 // Resolve for the compute pipeline (DESIGN.md section 6, step 3): per pixel,
-// the winning key's payload (fiblet, segment) becomes a G-buffer texel: the
-// fiber from the per-fiblet fiber table, the tangent from the rasters'
+// the winning key's payload (scene-global fiblet, segment) becomes a G-buffer
+// texel: the fiblet's dataset from the scene table (shared/scene_table.h),
+// the scene-global fiber from the dataset's per-fiblet fiber table plus its
+// fiber base, the tangent from the rasters'
 // tangent cache when there is one, else by decoding the fiblet from its
 // start up to the segment (sequential composition, at most 60 steps; only
 // covered pixels pay for it).
@@ -10,12 +12,18 @@
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 
 #include "shared/render_push.h"
+#include "shared/scene_table.h"
 #include "glsl/fiblet_record.glsl"
 #include "glsl/tangent.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;  // kPixelGroupSize
 
 layout(push_constant, std430) uniform Push { FibletResolvePush pc; };
+
+layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer SceneTableRef {
+  SceneTableHeader header;
+  SceneDataset datasets[];
+};
 
 void main() {
   const uvec2 p = gl_GlobalInvocationID.xy;
@@ -28,13 +36,23 @@ void main() {
   texel.segment = 0u;
   texel.tangent = 0u;
   if (key != 0xFFFFFFFFFFFFFFFFul) {
-    const FibletDataset ds = DatasetRef(pc.dataset).ds;
     const uint64_t payload = visibilityPayload(key);
-    const uint fiblet = uint(payload >> kKeySegmentBits);
+    const uint global = uint(payload >> kKeySegmentBits);
     const uint segment = uint(payload) & ((1u << kKeySegmentBits) - 1u);
+    // The last dataset whose first fiblet is at or before `global` (bases
+    // increase; a handful of entries, and neighbouring pixels take the same
+    // branch, so a scan beats a binary search's divergence).
+    SceneTableRef scene = SceneTableRef(pc.scene);
+    uint entry = 0u;
+    for (uint i = 1u; i < scene.header.count; ++i)
+      if (scene.datasets[i].fiblet_base <= global) entry = i;
+    const SceneDataset owner = scene.datasets[entry];
+    const FibletDataset ds = DatasetRef(owner.block).ds;
+    const uint fiblet = global - owner.fiblet_base;
     if (pc.tangents != 0ul) {
-      // The rasters left every drawn segment's tangent in the cache.
-      texel.tangent = UintsRef(pc.tangents).values[fiblet * 64u + segment];
+      // The rasters left every drawn segment's tangent in the cache
+      // (indexed by the global fiblet).
+      texel.tangent = UintsRef(pc.tangents).values[global * 64u + segment];
     } else {
       WordsRef records = WordsRef(ds.records);
       const uint base = fiblet * ds.record_words;
@@ -66,7 +84,7 @@ void main() {
       texel.tangent = packSegmentTangent(b - a);
     }
     texel.depth = visibilityDepth(key);
-    texel.fiber = UintsRef(ds.fiblet_fiber).values[fiblet];
+    texel.fiber = owner.fiber_base + UintsRef(ds.fiblet_fiber).values[fiblet];
     texel.segment = segment;
   }
   GBufferRef(pc.gbuffer).texels[index] = texel;

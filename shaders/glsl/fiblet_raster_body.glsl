@@ -140,13 +140,15 @@ void main() {
   vec4 a = cameraTransformPoint(cam.view_projection, a_world);
   const bool cache = pc.tangents != 0ul;
   UintsOutRef tangents = UintsOutRef(pc.tangents);
+  // Scene-global fiblet (shared/scene_table.h) for the keys and the cache.
+  const uint global = pc.fiblet_base + fiblet;
   for (uint j = 0u; j < run; ++j) {
     const uint k = first + j;
     if (k < end) {
       const vec3 b_world = fibletToWorld(ds, fibletRotate(e, local[j]) + e.t);  // point k + 1
       const vec4 b = cameraTransformPoint(cam.view_projection, b_world);
-      rasterClipSegment(vis, cam, a, b, (uint64_t(fiblet) << kKeySegmentBits) | uint64_t(k));
-      if (cache) tangents.values[fiblet * kSlots + k] = packSegmentTangent(b_world - a_world);
+      rasterClipSegment(vis, cam, a, b, (uint64_t(global) << kKeySegmentBits) | uint64_t(k));
+      if (cache) tangents.values[global * kSlots + k] = packSegmentTangent(b_world - a_world);
       a = b;
       a_world = b_world;
     }
@@ -157,7 +159,7 @@ void main() {
   if (owns_last && (flags & kFibletFlagEnds) == 0u && fiblet + 1u < ds.fiblet_count) {
     const vec3 b = fibletToWorld(ds, fibletFirstPoint(records, base + ds.record_words));
     rasterClipSegment(vis, cam, a, cameraTransformPoint(cam.view_projection, b),
-                      (uint64_t(fiblet) << kKeySegmentBits) | uint64_t(used));
-    if (cache) tangents.values[fiblet * kSlots + used] = packSegmentTangent(b - a_world);
+                      (uint64_t(global) << kKeySegmentBits) | uint64_t(used));
+    if (cache) tangents.values[global * kSlots + used] = packSegmentTangent(b - a_world);
   }
 }

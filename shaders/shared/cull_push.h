@@ -54,7 +54,11 @@ struct FibletCullPush {
   uint64_t camera;    // CameraBlock
   uint64_t list;      // FibletList: fiblets drawn at full detail
   uint64_t lod_list;  // FibletList: fiblets drawn as one segment (LoD)
-  uint64_t visible;   // uint per 32 fiblets: bit set = visible last frame (kCullPhase1/2)
+  // uint per 32 fiblets: bit set = visible last frame (kCullPhase1/2). The
+  // dataset's own region of the scene's bits (CullBuffers::visible at its
+  // word offset, a whole number of kCullGroupSize groups), so a workgroup
+  // still owns its two words when several datasets share the buffer.
+  uint64_t visible;
   uint64_t pyramid;   // float, every level of the max-depth pyramid (kCullPhase2)
   uint mode;          // kCull*
   float lod_pixels;   // LoD below this projected diameter in px; 0: off
@@ -87,6 +91,8 @@ struct FibletLodRasterPush {
   uint64_t visibility;
   uint64_t list;
   uint64_t tangents;  // 0 or the tangent cache (render_push.h): segment 0's entry
+  uint fiblet_base;   // as FibletRasterPush::fiblet_base
+  uint pad;
 };
 
 // Size of pyramid level `level` of a width x height frame: level 0 is the
@@ -127,7 +133,7 @@ SHADER_NAMESPACE_END
 static_assert(sizeof(fibscope::shader::FibletCullPush) == 64, "");
 static_assert(sizeof(fibscope::shader::FibletListFinalizePush) == 16, "");
 static_assert(sizeof(fibscope::shader::DepthPyramidPush) == 32, "");
-static_assert(sizeof(fibscope::shader::FibletLodRasterPush) == 40, "");
+static_assert(sizeof(fibscope::shader::FibletLodRasterPush) == 48, "");
 #endif
 
 #endif  // FIBSCOPE_SHADERS_SHARED_CULL_PUSH_H

@@ -19,14 +19,20 @@ struct FibletRasterPush {
   uint64_t list;
   // 0, or the tangent cache: uint per (fiblet, segment) at fiblet * 64 +
   // segment, the segment's packed unit tangent (glsl/tangent.glsl), so the
-  // resolve needs no decode.
+  // resolve needs no decode. Indexed by the GLOBAL fiblet.
   uint64_t tangents;
+  // The dataset's first fiblet in the scene's numbering (shared/scene_table.h):
+  // keys and the tangent cache use fiblet_base + the dataset's fiblet.
+  uint fiblet_base;
+  uint pad;
 };
 
-// fiblet_resolve.comp: visibility key -> G-buffer texel (fiber from the
-// per-fiblet fiber table, tangent by decoding the fiblet up to the segment).
+// fiblet_resolve.comp: visibility key -> G-buffer texel (the global
+// fiblet's dataset from the scene table, the global fiber from the dataset's
+// per-fiblet fiber table, the tangent from the cache or by decoding the
+// fiblet up to the segment).
 struct FibletResolvePush {
-  uint64_t dataset;
+  uint64_t scene;  // SceneTableHeader + SceneDataset[count] (shared/scene_table.h)
   uint64_t visibility;
   uint64_t gbuffer;   // GBufferTexel per pixel
   uint64_t tangents;  // 0: decode the fiblet up to the segment; else the rasters' tangent cache
@@ -37,7 +43,7 @@ struct FibletResolvePush {
 SHADER_NAMESPACE_END
 
 #ifdef __cplusplus
-static_assert(sizeof(fibscope::shader::FibletRasterPush) == 40, "");
+static_assert(sizeof(fibscope::shader::FibletRasterPush) == 48, "");
 static_assert(sizeof(fibscope::shader::FibletResolvePush) == 40, "");
 #endif
 

@@ -14,6 +14,8 @@
 #include <vulkan/vulkan.h>
 
 #include <cstdint>
+#include <span>
+#include <vector>
 
 #include "gpu/buffer.h"
 #include "gpu/compute_pipeline.h"
@@ -23,6 +25,7 @@
 #include "render/gpu_dataset.h"
 #include "render/gpu_fiblet_passes.h"
 #include "render/gpu_frame_targets.h"
+#include "render/gpu_scene_table.h"
 #include "render/render_settings.h"
 
 namespace fibscope {
@@ -37,28 +40,47 @@ struct CullPasses {
 CullPasses createCullPasses(const gpu::VulkanContext& context);
 void destroyCullPasses(const gpu::VulkanContext& context, CullPasses& passes);
 
-// Scratch that lives across frames. The visible bits are the two-phase
-// history: bit f of word f / 32 is set when fiblet f passed the occlusion
-// test of the last frame.
-struct CullBuffers {
-  gpu::Buffer list;      // FibletListHeader + uint per fiblet (full detail), indirect
-  gpu::Buffer lod_list;  // FibletListHeader + uint per fiblet (LoD), indirect
-  gpu::Buffer visible;   // uint per 32 fiblets, rounded up to 64 fiblets
-  gpu::Buffer pyramid;   // float, every level (pyramidLevelOffset)
-  gpu::Buffer stats;     // readback: uint[4] = full / LoD counts of phase 1 (or the only phase), phase 2
-  uint32_t fiblet_capacity = 0;
-  uint32_t width = 0, height = 0;  // of the pyramid
-  // The visible bits describe the last frame of this dataset (by its block
-  // address) drawn with TwoPhase at this size; otherwise the next TwoPhase
-  // frame marks every fiblet visible first.
-  bool history_valid = false;
-  VkDeviceAddress history_dataset = 0;
+// Where one drawn dataset's lists and visible bits lie in CullBuffers.
+// Each dataset of a scene is culled and drawn by dispatches of its own
+// (the pushes name one dataset block), into lists of its own: regions of
+// the shared list buffers, so the culls of all datasets run back to back
+// without barriers between them and each indirect raster reads its region.
+struct CullRegion {
+  VkDeviceSize list_offset = 0;     // of its FibletListHeader in list and lod_list (16-byte aligned)
+  VkDeviceSize visible_offset = 0;  // of its first bit word in visible (whole kCullGroupSize groups)
+  uint32_t fiblets = 0;
 };
 
-// Makes the buffers fit `fiblets` fiblets and a width x height frame,
+// Scratch that lives across frames. The visible bits are the two-phase
+// history: bit f of word f / 32 of a dataset's region is set when its
+// fiblet f passed the occlusion test of the last frame.
+struct CullBuffers {
+  gpu::Buffer list;      // per region: FibletListHeader + uint per fiblet (full detail), indirect
+  gpu::Buffer lod_list;  // per region: FibletListHeader + uint per fiblet (LoD), indirect
+  gpu::Buffer visible;   // per region: uint per 32 fiblets, rounded up to 64 fiblets
+  gpu::Buffer pyramid;   // float, every level (pyramidLevelOffset)
+  // readback: uint[4] per region = full / LoD counts of phase 1 (or the
+  // only phase), phase 2
+  gpu::Buffer stats;
+  std::vector<CullRegion> regions;  // of the last prepareCullBuffers
+  VkDeviceSize list_capacity = 0, visible_capacity = 0;  // bytes
+  uint32_t width = 0, height = 0;  // of the pyramid
+  // The visible bits describe the last frame of this scene (by its
+  // datasets' block addresses and counts, sameScene) drawn with TwoPhase at
+  // this size; otherwise the next TwoPhase frame marks every fiblet visible
+  // first.
+  bool history_valid = false;
+  SceneLayout history_scene;
+};
+
+// Makes the buffers fit datasets of `dataset_fiblets` fiblets (one region
+// each, in order; at most kMaxSceneDatasets) and a width x height frame,
 // reallocating what is too small (lists, bits) or of another size
 // (pyramid); either invalidates the history. Throws Error when memory runs
 // out (the buffers are then released).
+void prepareCullBuffers(const gpu::VulkanContext& context, CullBuffers& buffers,
+                        std::span<const uint32_t> dataset_fiblets, uint32_t width, uint32_t height);
+// One dataset.
 void prepareCullBuffers(const gpu::VulkanContext& context, CullBuffers& buffers, uint32_t fiblets, uint32_t width,
                         uint32_t height);
 void destroyCullBuffers(const gpu::VulkanContext& context, CullBuffers& buffers);
@@ -81,24 +103,30 @@ struct CullFrame {
 // l * focal / z pixels.
 float cullFocalPixels(const Camera& camera);
 
-// Records the culled decode + raster into frame.visibility (cleared by the
-// caller, camera block written, both made visible to compute), with
+// Records the culled decode + raster of every dataset of `scene` (regions
+// prepared by prepareCullBuffers for its datasets' fiblet counts, in
+// order) into frame.visibility (cleared by the caller, camera block
+// written, both made visible to compute), with
 // timestamps per pass on `timer` and barriers between its passes; ends with
 // the raster's compute writes (the caller's barrier before the resolve
 // covers them) and the statistics copied for readCullStats. TwoPhase
 // starts from "every fiblet visible" when the history is not valid (first
-// frame, new size or dataset, a frame of another mode in between): phase 1
+// frame, new size or scene, a frame of another mode in between): phase 1
 // then draws everything in the frustum and phase 2 learns the true bits at
 // once, whereas starting from "none visible" would draw the same in phase 2
 // against an empty pyramid and learn nothing until the next frame.
+// Several datasets share each phase: all culls, all finalizes, all rasters,
+// and one pyramid of everything phase 1 drew, so a fiber of one model
+// occludes the fiblets of another.
 //   Frustum:  cull -> finalize -> raster + LoD raster.
 //   TwoPhase: phase-1 cull -> finalize -> raster + LoD raster -> depth
 //             pyramid -> phase-2 cull -> finalize -> raster + LoD raster.
 void recordCulledRaster(VkCommandBuffer cmd, const gpu::VulkanContext& context, const CullPasses& passes,
-                        const FibletPasses& fiblet_passes, const GpuDataset& dataset, const GpuFrameTargets& frame,
+                        const FibletPasses& fiblet_passes, const SceneLayout& scene, const GpuFrameTargets& frame,
                         CullBuffers& buffers, const CullFrame& cull, gpu::GpuTimer& timer);
 
-// The fiblets drawn by the last recorded frame, once it has completed.
+// The fiblets drawn by the last recorded frame (summed over its datasets),
+// once it has completed.
 struct CullStats {
   uint64_t phase1_full = 0, phase1_lod = 0;  // Frustum: the only phase
   uint64_t phase2_full = 0, phase2_lod = 0;

@@ -97,7 +97,7 @@ uint32_t pixelGroupsY(const GpuFrameTargets& frame) {
 }
 
 void recordFibletRasterAll(VkCommandBuffer cmd, const gpu::VulkanContext& context, const FibletPasses& passes,
-                           const GpuDataset& dataset, const GpuFrameTargets& frame) {
+                           const GpuDataset& dataset, const GpuFrameTargets& frame, uint32_t fiblet_base) {
   const uint32_t fiblets = dataset.block().fiblet_count;
   if (fiblets == 0) return;
   shader::FibletRasterPush push{};
@@ -106,28 +106,31 @@ void recordFibletRasterAll(VkCommandBuffer cmd, const gpu::VulkanContext& contex
   push.visibility = frame.visibility.address;
   push.list = 0;
   push.tangents = frame.tangents.address;
+  push.fiblet_base = fiblet_base;
   const gpu::DispatchGrid grid =
       gpu::dispatchGrid(context, (uint64_t(fiblets) + passes.raster_fiblets_per_group - 1) / passes.raster_fiblets_per_group);
   gpu::recordDispatch(cmd, passes.raster, push, grid.x, grid.y);
 }
 
 void recordFibletRasterList(VkCommandBuffer cmd, const FibletPasses& passes, const GpuDataset& dataset,
-                            const GpuFrameTargets& frame, const gpu::Buffer& list) {
+                            const GpuFrameTargets& frame, const gpu::Buffer& list, VkDeviceSize list_offset,
+                            uint32_t fiblet_base) {
   shader::FibletRasterPush push{};
   push.dataset = dataset.blockAddress();
   push.camera = frame.camera.address;
   push.visibility = frame.visibility.address;
-  push.list = list.address;
+  push.list = list.address + list_offset;
   push.tangents = frame.tangents.address;
+  push.fiblet_base = fiblet_base;
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, passes.raster.pipeline);
   vkCmdPushConstants(cmd, passes.raster.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
-  vkCmdDispatchIndirect(cmd, list.buffer, 0);
+  vkCmdDispatchIndirect(cmd, list.buffer, list_offset);
 }
 
-void recordFibletResolve(VkCommandBuffer cmd, const FibletPasses& passes, const GpuDataset& dataset,
+void recordFibletResolve(VkCommandBuffer cmd, const FibletPasses& passes, VkDeviceAddress scene_table,
                          const GpuFrameTargets& frame) {
   shader::FibletResolvePush push{};
-  push.dataset = dataset.blockAddress();
+  push.scene = scene_table;
   push.visibility = frame.visibility.address;
   push.gbuffer = frame.gbuffer.address;
   push.tangents = frame.tangents.address;

@@ -44,15 +44,22 @@ FibletPasses createFibletPasses(const gpu::VulkanContext& context, uint32_t rast
                                 RasterScan scan = RasterScan::Auto);
 void destroyFibletPasses(const gpu::VulkanContext& context, FibletPasses& passes);
 
-// Every fiblet of the dataset, one workgroup each.
+// Every fiblet of the dataset, one workgroup each. `fiblet_base`: the
+// dataset's first fiblet in the scene's numbering (render/gpu_scene_table.h;
+// 0 for a dataset drawn alone), which the keys and the tangent cache use.
 void recordFibletRasterAll(VkCommandBuffer cmd, const gpu::VulkanContext& context, const FibletPasses& passes,
-                           const GpuDataset& dataset, const GpuFrameTargets& frame);
-// The fiblets of `list` (shared/fiblet_list.h), dispatched indirectly from
-// the list's header; the list must have been finalised (dispatch size
-// written) and made visible to indirect reads.
+                           const GpuDataset& dataset, const GpuFrameTargets& frame, uint32_t fiblet_base = 0);
+// The fiblets of the list at `list_offset` in `list` (shared/fiblet_list.h;
+// the dataset's own fiblet indices), dispatched indirectly from the list's
+// header; the list must have been finalised (dispatch size written) and
+// made visible to indirect reads.
 void recordFibletRasterList(VkCommandBuffer cmd, const FibletPasses& passes, const GpuDataset& dataset,
-                            const GpuFrameTargets& frame, const gpu::Buffer& list);
-void recordFibletResolve(VkCommandBuffer cmd, const FibletPasses& passes, const GpuDataset& dataset,
+                            const GpuFrameTargets& frame, const gpu::Buffer& list, VkDeviceSize list_offset = 0,
+                            uint32_t fiblet_base = 0);
+// Every pixel: the winning key's global fiblet -> its dataset through the
+// scene table at `scene_table` (shared/scene_table.h, made visible to
+// compute) -> the G-buffer texel with the global fiber.
+void recordFibletResolve(VkCommandBuffer cmd, const FibletPasses& passes, VkDeviceAddress scene_table,
                          const GpuFrameTargets& frame);
 
 // Workgroups of kPixelGroupSize^2 covering the frame.

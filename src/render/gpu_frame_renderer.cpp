@@ -20,6 +20,7 @@ FrameRenderer::FrameRenderer(const gpu::VulkanContext& context, uint32_t width, 
     cull_passes_ = createCullPasses(context);
     raw_passes_ = createRawPasses(context);
     shade_pass_ = createShadePass(context, width, height);
+    scene_table_ = createSceneTableBuffer(context);
     timer_ = gpu::createGpuTimer(context, kMaxPassesPerFrame);
   } catch (...) {
     release();
@@ -31,6 +32,7 @@ FrameRenderer::~FrameRenderer() { release(); }
 
 void FrameRenderer::release() {
   gpu::destroyGpuTimer(context_, timer_);
+  gpu::destroyBuffer(context_, scene_table_);
   destroyShadePass(context_, shade_pass_);
   destroyLinesPass(context_, lines_pass_);
   destroyRawPasses(context_, raw_passes_);
@@ -53,7 +55,7 @@ void FrameRenderer::resize(uint32_t width, uint32_t height) {
   }
   destroyFrameTargets(context_, targets_);
   targets_ = fresh;
-  tangent_cache_for_ = 0;  // the fresh targets have no tangent cache
+  tangent_cache_for_ = UINT64_MAX;  // the fresh targets have no tangent cache
 }
 
 void FrameRenderer::record(VkCommandBuffer cmd, const Camera& camera, const RenderSettings& settings,
@@ -64,8 +66,10 @@ void FrameRenderer::record(VkCommandBuffer cmd, const Camera& camera, const Rend
   if (!(settings.line_width_px >= kMinLineWidth && settings.line_width_px <= kMaxLineWidth))
     throw Error("render: line width must lie in [1, 4] px, got " + std::to_string(settings.line_width_px));
   validateShadeSettings(settings);
-  if (settings.pipeline == RenderPipeline::Compute && !scene.fiblets)
+  if (settings.pipeline == RenderPipeline::Compute && scene.datasets.empty())
     throw Error("render: the compute pipeline needs fiblets");
+  for (const GpuDataset* dataset : scene.datasets)
+    if (!dataset) throw Error("render: a null dataset in the scene");
   if (settings.pipeline != RenderPipeline::Compute && !scene.raw)
     throw Error("render: the " + std::string(renderPipelineName(settings.pipeline)) +
                 " pipeline needs the raw tractogram");
@@ -113,29 +117,33 @@ void FrameRenderer::record(VkCommandBuffer cmd, const Camera& camera, const Rend
     gpu::endPass(cmd, timer_);
     gpu::computeToComputeBarrier(cmd);
   } else {
-    const GpuDataset& dataset = *scene.fiblets;
-    pending_.fiblets_total = dataset.block().fiblet_count;
-    // The rasters keep each drawn segment's tangent so the resolve need
-    // not decode again (when the dataset's cache fits the budget): sized
-    // once per dataset, not per frame.
-    // (A cache smaller than the dataset is never used: a new dataset may
-    // reuse a destroyed one's address.)
-    const uint64_t cache_bytes = uint64_t(dataset.block().fiblet_count) * 64 * sizeof(uint32_t);
-    if (tangent_cache_for_ != dataset.blockAddress() ||
-        (targets_.tangents.buffer && targets_.tangents.size < cache_bytes)) {
-      prepareTangentCache(context_, targets_, dataset.block().fiblet_count);
-      tangent_cache_for_ = dataset.blockAddress();
+    // Scene-global numbering (gpu_scene_table.h): Error above 2^28 fiblets.
+    layout_ = fibscope::sceneLayout(scene.datasets);
+    pending_.fiblets_total = layout_.fiblets;
+    recordSceneTableUpdate(cmd, scene_table_, layout_);
+    // The rasters keep each drawn segment's tangent (at the global fiblet)
+    // so the resolve need not decode again (when the scene's cache fits the
+    // budget): sized when the scene's fiblet total changes, not per frame.
+    // (The cache's contents never outlive a frame: every frame's rasters
+    // write what its resolve reads.)
+    if (tangent_cache_for_ != layout_.fiblets) {
+      prepareTangentCache(context_, targets_, layout_.fiblets);
+      tangent_cache_for_ = layout_.fiblets;
     }
     cull_stats_pending_ = settings.culling != CullingMode::None && pending_.fiblets_total > 0;
     if (cull_stats_pending_) {
       // Cull passes, both rasters (and the pyramid and second phase for
-      // TwoPhase); fiblets_drawn and fiblets_lod come from collect().
-      prepareCullBuffers(context_, cull_buffers_, dataset.block().fiblet_count, targets_.width, targets_.height);
-      recordCulledRaster(cmd, context_, cull_passes_, fiblet_passes_, dataset, targets_, cull_buffers_,
+      // TwoPhase) of every dataset; fiblets_drawn and fiblets_lod come from
+      // collect().
+      std::vector<uint32_t> fiblets;
+      for (const SceneEntry& e : layout_.entries) fiblets.push_back(e.dataset->block().fiblet_count);
+      prepareCullBuffers(context_, cull_buffers_, fiblets, targets_.width, targets_.height);
+      recordCulledRaster(cmd, context_, cull_passes_, fiblet_passes_, layout_, targets_, cull_buffers_,
                          CullFrame{settings.culling, settings.lod_pixels, cullFocalPixels(camera)}, timer_);
     } else {
       gpu::beginPass(cmd, timer_, "raster");
-      recordFibletRasterAll(cmd, context_, fiblet_passes_, dataset, targets_);
+      for (const SceneEntry& e : layout_.entries)
+        recordFibletRasterAll(cmd, context_, fiblet_passes_, *e.dataset, targets_, e.fiblet_base);
       gpu::endPass(cmd, timer_);
       pending_.fiblets_drawn = pending_.fiblets_total;
       cull_buffers_.history_valid = false;  // two-phase history skips this frame
@@ -143,15 +151,14 @@ void FrameRenderer::record(VkCommandBuffer cmd, const Camera& camera, const Rend
     gpu::computeToComputeBarrier(cmd);
 
     gpu::beginPass(cmd, timer_, "resolve");
-    recordFibletResolve(cmd, fiblet_passes_, dataset, targets_);
+    recordFibletResolve(cmd, fiblet_passes_, scene_table_.address, targets_);
     gpu::endPass(cmd, timer_);
     gpu::computeToComputeBarrier(cmd);
   }
 
   // Per-fiber attributes cover the fibers of the tractogram drawn.
   ShadeFiberInputs fibers{scene.fiber_scalars, scene.selection_bits, 0};
-  fibers.fiber_count = settings.pipeline == RenderPipeline::Compute ? scene.fiblets->block().fiber_count
-                                                                    : scene.raw->streamlineCount();
+  fibers.fiber_count = settings.pipeline == RenderPipeline::Compute ? layout_.fibers : scene.raw->streamlineCount();
   recordShade(cmd, shade_pass_, targets_, settings, &timer_, fibers);
 }
 

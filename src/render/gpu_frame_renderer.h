@@ -20,21 +20,33 @@
 #include "render/gpu_lines_pass.h"
 #include "render/gpu_raw_passes.h"
 #include "render/gpu_raw_tractogram.h"
+#include "render/gpu_scene_table.h"
 #include "render/gpu_shade_pass.h"
 #include "render/render_settings.h"
 
 namespace fibscope {
 
-// What a frame draws: the fiblets (compute pipeline) and, for the
-// baselines, the same tractogram as raw float vertices. A pipeline whose
-// input is missing is an Error when the frame is recorded.
+// What a frame draws: the fiblets of one or more datasets (compute
+// pipeline), drawn together into one visibility buffer (the nearest fiber
+// wins across datasets) with scene-global fiblet and fiber ids
+// (render/gpu_scene_table.h: dataset i's fibers are fiber_base_i + its
+// own), and, for the baselines, one tractogram as raw float vertices. A
+// pipeline whose input is missing is an Error when the frame is recorded.
 struct GpuScene {
-  const GpuDataset* fiblets = nullptr;
-  const GpuRawTractogram* raw = nullptr;  // lines and raw-compute
+  GpuScene() = default;
+  // One dataset (or none), as most callers draw.
+  GpuScene(const GpuDataset* fiblets, const GpuRawTractogram* raw_vertices = nullptr) : raw(raw_vertices) {
+    if (fiblets) datasets.push_back(fiblets);
+  }
+
+  std::vector<const GpuDataset*> datasets;  // in drawing order (none null); the scene's fiber ids follow it
+  const GpuRawTractogram* raw = nullptr;    // lines and raw-compute (one tractogram)
   // Per-fiber attributes (src/render/gpu_fiber_attributes.h), indexed by
-  // the G-buffer's fiber id; 0 means none. Each must hold an entry for
-  // every fiber of the drawn tractogram.
-  VkDeviceAddress fiber_scalars = 0;   // float per fiber (ColorMode::Scalar), e.g. GpuDataset::fiberLength()
+  // the G-buffer's fiber id (scene-global: for one dataset its own ids); 0
+  // means none. Each must hold an entry for every fiber of the drawn
+  // datasets (the raw tractogram's, for the baselines), e.g.
+  // GpuSceneFiberLengths for the scalars.
+  VkDeviceAddress fiber_scalars = 0;   // float per fiber (ColorMode::Scalar)
   VkDeviceAddress selection_bits = 0;  // uint words: fiber f selected when bit f % 32 of word f / 32 is set;
                                        // 0 also means an empty selection (nothing dimmed)
 };
@@ -61,6 +73,9 @@ class FrameRenderer {
   FrameStats render(const Camera& camera, const RenderSettings& settings, const GpuScene& scene);
 
   const GpuFrameTargets& targets() const { return targets_; }
+  // The numbering of the last compute frame recorded (its G-buffer's fiber
+  // ids: locateSceneFiber maps them to a dataset and its fiber).
+  const SceneLayout& sceneLayout() const { return layout_; }
 
  private:
   void release();
@@ -71,8 +86,11 @@ class FrameRenderer {
   CullPasses cull_passes_;
   CullBuffers cull_buffers_;  // lists, pyramid and the two-phase visible bits (kept across frames)
   bool cull_stats_pending_ = false;  // the last frame was culled: collect() reads its counts
-  // The dataset (its block's address) targets_.tangents was sized for.
-  VkDeviceAddress tangent_cache_for_ = 0;
+  gpu::Buffer scene_table_;  // shared/scene_table.h, written each compute frame
+  SceneLayout layout_;
+  // The scene fiblet total targets_.tangents was prepared for (UINT64_MAX:
+  // none yet).
+  uint64_t tangent_cache_for_ = UINT64_MAX;
   RawPasses raw_passes_;
   LinesPass lines_pass_;  // created at the first lines frame
   ShadePass shade_pass_;

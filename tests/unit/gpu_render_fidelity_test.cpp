@@ -21,6 +21,7 @@
 #include "phantom/phantom.h"
 #include "render/camera.h"
 #include "render/gpu_frame_renderer.h"
+#include "render/gpu_scene_table.h"
 #include "render/gpu_tractogram_upload.h"
 #include "render/image_compare.h"
 #include "render/reference_raster.h"
@@ -106,12 +107,16 @@ TEST_F(GpuRenderFidelity, everyRasterWidthMatchesTheReference) {
     const uint32_t lanes = variant.lanes;
     SCOPED_TRACE("lanes " + std::to_string(lanes) + (variant.scan == RasterScan::Subgroup ? ", subgroup scan" : ""));
     FibletPasses passes = createFibletPasses(context(), lanes, variant.scan);
+    gpu::Buffer table = createSceneTableBuffer(context());  // the one dataset at bases 0
+    const GpuDataset* datasets[] = {&upload.dataset};
+    const SceneLayout layout = sceneLayout(datasets);
     // Raster + resolve alone (no culling, no shading), as a frame records them.
     auto drawAndResolve = [&] {
       gpu::submitOnce(context(), [&](VkCommandBuffer cmd) {
         const shader::CameraBlock block = makeCameraBlock(camera, 2.0f);
         vkCmdUpdateBuffer(cmd, frame.camera.buffer, 0, sizeof(block), &block);
         vkCmdFillBuffer(cmd, frame.visibility.buffer, 0, VK_WHOLE_SIZE, 0xFFFFFFFFu);
+        recordSceneTableUpdate(cmd, table, layout);
         gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                            VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                            VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
@@ -119,7 +124,7 @@ TEST_F(GpuRenderFidelity, everyRasterWidthMatchesTheReference) {
         gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                            VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT,
                            VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
-        recordFibletResolve(cmd, passes, upload.dataset, frame);
+        recordFibletResolve(cmd, passes, table.address, frame);
       });
       return downloadGBuffer(context(), frame);
     };
@@ -141,6 +146,7 @@ TEST_F(GpuRenderFidelity, everyRasterWidthMatchesTheReference) {
       differ += std::fabs(a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) < 0.99999;
     }
     EXPECT_EQ(differ, 0u) << "of " << covered << " covered pixels have different tangents";
+    gpu::destroyBuffer(context(), table);
     destroyFibletPasses(context(), passes);
     const std::vector<uint8_t> mask = gbufferMask(decoded);
     const CoverageComparison c = compareCoverage(mask, reference.coverageMask(), kSize, kSize);

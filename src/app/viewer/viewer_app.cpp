@@ -641,7 +641,7 @@ void ViewerApp::pickAt(const PickAction& pick) {
 
 GpuScene ViewerApp::withSelection(GpuScene scene) const {
   // The bits are sized for the selection's dataset: never for another one.
-  if (scene.fiblets && scene.fiblets == selection_->dataset()) scene.selection_bits = selection_->bits();
+  if (scene.datasets.size() == 1 && scene.datasets[0] == selection_->dataset()) scene.selection_bits = selection_->bits();
   return scene;
 }
 
