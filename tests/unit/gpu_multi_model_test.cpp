@@ -5,6 +5,8 @@
 // on (GpuTest fails on any message).
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -112,7 +114,7 @@ TEST_F(GpuMultiModel, twoModelsDrawnTogetherMatchTheReferenceOfTheirUnion) {
     // The winning (model, fiber) is the reference's union fiber.
     alone.render(camera, settings, GpuScene{&a()});
     const auto only_a = downloadGBuffer(context(), alone.targets());
-    size_t both_cover = 0, same = 0, b_wins = 0, b_over_a = 0;
+    size_t both_cover = 0, same = 0, b_wins = 0, b_over_a = 0, same_tangent = 0;
     for (size_t i = 0; i < texels.size(); ++i) {
       if (texels[i].fiber == shader::kNoFiberId) continue;
       const bool from_b = texels[i].fiber >= fibersA();
@@ -121,9 +123,15 @@ TEST_F(GpuMultiModel, twoModelsDrawnTogetherMatchTheReferenceOfTheirUnion) {
       b_over_a += from_b && only_a[i].fiber != shader::kNoFiberId;
       if (reference.fiber[i] == kNoFiber) continue;
       ++both_cover;
-      same += texels[i].fiber == reference.fiber[i];
+      if (texels[i].fiber != reference.fiber[i]) continue;
+      ++same;
+      // The tangent cache is indexed by the global fiblet: B's tangents are
+      // its own, not those of A's fiblet with the same index.
+      const std::array<float, 3> t = test::unpackTangent(texels[i].tangent), r = reference.tangent[i];
+      same_tangent += std::fabs(t[0] * r[0] + t[1] * r[1] + t[2] * r[2]) > 0.9f;
     }
     EXPECT_GE(double(same), 0.95 * double(both_cover)) << same << " of " << both_cover;
+    EXPECT_GE(double(same_tangent), 0.95 * double(same)) << same_tangent << " of " << same;
     EXPECT_GT(b_wins, texels.size() / 50) << "model B is drawn";
     EXPECT_GT(b_over_a, 100u) << "B's fibers win pixels A also covers";
     EXPECT_LT(b_wins, c.covered_a - texels.size() / 50) << "model A is drawn too";
