@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <thread>
 #include <string>
 
 #include "core/error.h"
@@ -163,6 +165,68 @@ void putChunk(std::vector<uint8_t>& out, const char type[4], const std::vector<u
   putU32(out, uint32_t(crc32(0L, out.data() + type_at, uInt(4 + data.size()))));
 }
 
+// The zlib stream of the image's scanlines (each row after filter byte 0,
+// none), deflated in bands of rows on every core: each band is an
+// independent raw deflate stream that ends on a byte boundary without the
+// final bit (Z_SYNC_FLUSH; the last band Z_FINISH), so the bands joined
+// after a zlib header form one valid stream (the method of pigz); the
+// Adler-32 of the whole is combined from the bands'. A band's matches never
+// reach into the band before, which costs a little compression at each seam.
+// A 1920x1080 frame: ~0.09 s on one core, about half on two.
+std::vector<uint8_t> deflateScanlines(const std::string& path, uint32_t width, uint32_t height,
+                                      const std::vector<uint8_t>& rgba) {
+  const size_t row_bytes = size_t(width) * 4;
+  const unsigned bands = std::clamp<unsigned>(height / 64, 1, std::max(1u, std::thread::hardware_concurrency()));
+  struct Band {
+    std::vector<uint8_t> packed;
+    uLong adler = 0;
+    uLong raw_bytes = 0;
+    bool ok = false;
+  };
+  std::vector<Band> out(bands);
+  auto deflateBand = [&](unsigned b) {
+    const uint32_t y0 = uint32_t(uint64_t(height) * b / bands), y1 = uint32_t(uint64_t(height) * (b + 1) / bands);
+    const size_t raw_size = (row_bytes + 1) * (y1 - y0);
+    if (raw_size > 0xFFFFFFFFu) return;  // zlib counts in 32 bits: reported below
+    std::vector<uint8_t> raw(raw_size);
+    for (uint32_t y = y0; y < y1; ++y) {
+      uint8_t* row = raw.data() + (y - y0) * (row_bytes + 1);
+      row[0] = 0;
+      std::memcpy(row + 1, rgba.data() + y * row_bytes, row_bytes);
+    }
+    Band& band = out[b];
+    z_stream z{};
+    if (deflateInit2(&z, Z_BEST_SPEED, Z_DEFLATED, -15, 8, Z_DEFAULT_STRATEGY) != Z_OK) return;
+    band.packed.resize(deflateBound(&z, uLong(raw_size)) + 64);  // + the empty stored block of the flush
+    z.next_in = raw.data();
+    z.avail_in = uInt(raw_size);
+    z.next_out = band.packed.data();
+    z.avail_out = uInt(band.packed.size());
+    const bool last = b + 1 == bands;
+    const int status = deflate(&z, last ? Z_FINISH : Z_SYNC_FLUSH);
+    band.ok = (last ? status == Z_STREAM_END : status == Z_OK) && z.avail_in == 0;
+    band.packed.resize(z.total_out);
+    deflateEnd(&z);
+    band.adler = adler32(adler32(0L, Z_NULL, 0), raw.data(), uInt(raw_size));
+    band.raw_bytes = uLong(raw_size);
+  };
+  {
+    std::vector<std::jthread> helpers;
+    for (unsigned b = 1; b < bands; ++b) helpers.emplace_back(deflateBand, b);
+    deflateBand(0);
+  }
+  std::vector<uint8_t> stream = {0x78, 0x01};  // deflate, 32 KiB window, fastest
+  uLong adler = adler32(0L, Z_NULL, 0);
+  for (const Band& band : out) {
+    if (!band.ok) fail(path, "PNG: zlib compression failed (image of " + std::to_string(width) + " x " +
+                                 std::to_string(height) + " px)");
+    stream.insert(stream.end(), band.packed.begin(), band.packed.end());
+    adler = adler32_combine(adler, band.adler, z_off_t(band.raw_bytes));
+  }
+  putU32(stream, uint32_t(adler));
+  return stream;
+}
+
 }  // namespace
 
 void writePngRgba(const std::string& path, uint32_t width, uint32_t height, const std::vector<uint8_t>& rgba) {
@@ -173,18 +237,7 @@ void writePngRgba(const std::string& path, uint32_t width, uint32_t height, cons
   if (rgba.size() != row_bytes * height)
     fail(path, "PNG: expected " + std::to_string(row_bytes * height) + " RGBA bytes, got " +
                    std::to_string(rgba.size()));
-  // Scanlines, each preceded by filter type 0 (none).
-  std::vector<uint8_t> raw;
-  raw.reserve((row_bytes + 1) * height);
-  for (uint32_t y = 0; y < height; ++y) {
-    raw.push_back(0);
-    raw.insert(raw.end(), rgba.begin() + std::ptrdiff_t(y * row_bytes), rgba.begin() + std::ptrdiff_t((y + 1) * row_bytes));
-  }
-  uLongf packed_size = compressBound(uLong(raw.size()));
-  std::vector<uint8_t> packed(packed_size);
-  if (compress2(packed.data(), &packed_size, raw.data(), uLong(raw.size()), Z_BEST_SPEED) != Z_OK)
-    fail(path, "PNG: zlib compression failed");
-  packed.resize(packed_size);
+  const std::vector<uint8_t> packed = deflateScanlines(path, width, height, rgba);
 
   std::vector<uint8_t> png = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
   std::vector<uint8_t> ihdr;
