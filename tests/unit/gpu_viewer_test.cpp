@@ -9,6 +9,7 @@
 #include <GLFW/glfw3.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 #include <optional>
 #include <string>
@@ -740,6 +741,122 @@ TEST_F(GpuViewer, scriptLoadRunsOnTheWorkerWhileFramesGoOn) {
   const Png png = readOurPng(scene);
   ASSERT_EQ(png.width, 96u);
   EXPECT_GT(coverage(png, 0, 0, 96, 64), 0.05);
+}
+
+// --- several models (issue 5, item 3): every visible model in one frame ----
+
+class GpuMultiModelViewer : public GpuViewer {};
+
+// A phantom compressed to a .fbl (opened as stored: its decode is the
+// reference the export is compared with).
+Tractogram compressPhantom(const std::string& fbl, uint64_t seed) {
+  CompressOptions options;
+  options.terminal_progress = false;
+  options.threads = 1;
+  compressTractogram(
+      [seed] {
+        PhantomOptions p;
+        p.streamlines = 300;
+        p.seed = seed;
+        p.threads = 1;
+        return openPhantom(p);
+      },
+      fbl, options);
+  return readAllStreamlines(*openFbl(fbl));
+}
+
+TEST_F(GpuMultiModelViewer, twoModelsAreDrawnTogetherHiddenAndPickedByModel) {
+  // Two phantoms of different seeds: the same brain-like shape, different
+  // fibers, overlapping everywhere.
+  const std::string fbl_a = dir_.file("a.fbl"), fbl_b = dir_.file("b.fbl");
+  const Tractogram fibers_a = compressPhantom(fbl_a, 3), fibers_b = compressPhantom(fbl_b, 8);
+
+  // The scene with A alone (B hidden), B alone, and both: same camera (the
+  // view is framed on both when they are loaded, not when one is hidden).
+  const std::string look = dir_.file("look.txt");
+  const std::string png_a = dir_.file("a.png"), png_b = dir_.file("b.png"), png_both = dir_.file("both.png");
+  test::writeBytes(look, "wait 2\nmodel 1 hide\nwait 1\nscreenshot " + png_a +
+                             " 320x200\nmodel 1 show\nmodel 0 hide\nwait 1\nscreenshot " + png_b +
+                             " 320x200\nmodel 0 show\nwait 1\nscreenshot " + png_both + " 320x200\nquit\n");
+  auto r = runViewer("--offscreen --size 320x200 --script " + look + " " + fbl_a + " " + fbl_b);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Png a = readOurPng(png_a), b = readOurPng(png_b), both = readOurPng(png_both);
+  ASSERT_EQ(both.width, 320u);
+  const double cover_a = coverage(a, 0, 0, 320, 200), cover_b = coverage(b, 0, 0, 320, 200);
+  const double cover_both = coverage(both, 0, 0, 320, 200);
+  std::printf("covered: A %.3f, B %.3f, both %.3f\n", cover_a, cover_b, cover_both);
+  EXPECT_GT(cover_a, 0.05);
+  EXPECT_GT(cover_b, 0.05);
+  EXPECT_GT(cover_both, std::max(cover_a, cover_b) + 0.01) << "both models are drawn";
+  EXPECT_LE(cover_both, cover_a + cover_b + 0.005);
+
+  // P: covered (3x3) with both shown and with B alone, nothing of A within
+  // 3 px: B's fiber wins there. Q likewise for A.
+  auto block = [](const Png& png, uint32_t x, uint32_t y, int radius, bool want) {
+    for (int dy = -radius; dy <= radius; ++dy)
+      for (int dx = -radius; dx <= radius; ++dx)
+        if (covered(png, uint32_t(int(x) + dx), uint32_t(int(y) + dy)) != want) return false;
+    return true;
+  };
+  std::optional<std::pair<uint32_t, uint32_t>> p, q;
+  for (uint32_t y = 4; y + 4 < 200; ++y)
+    for (uint32_t x = 4; x + 4 < 320; ++x) {
+      if (!p && block(both, x, y, 1, true) && block(b, x, y, 1, true) && block(a, x, y, 3, false)) p = {x, y};
+      if (!q && block(both, x, y, 1, true) && block(a, x, y, 1, true) && block(b, x, y, 3, false)) q = {x, y};
+    }
+  ASSERT_TRUE(p && q) << "no pixel of one model alone";
+  auto at = [](const std::pair<uint32_t, uint32_t>& v) {
+    return std::to_string(v.first) + " " + std::to_string(v.second);
+  };
+
+  // Pick B's fiber at P, add A's at Q; export with A active writes A's
+  // fiber only, with B active B's; hide B and P is background.
+  const std::string pick = dir_.file("pick.txt"), sel_png = dir_.file("sel.png");
+  const std::string tck_b = dir_.file("b.tck"), tck_a = dir_.file("a.tck"), tck_last = dir_.file("last.tck");
+  test::writeBytes(pick, "wait 2\n"
+                         "pick " + at(*p) + "\n"
+                         "expect-selected 1\n"
+                         "model 0 activate\n"  // A has no selected fiber: the export writes B's
+                         "export-selection " + tck_last + "\n"
+                         "screenshot " + sel_png + " 320x200\n"
+                         "pick " + at(*q) + " add\n"
+                         "expect-selected 2\n"
+                         "export-selection " + tck_a + "\n"
+                         "model 1 activate\n"
+                         "export-selection " + tck_b + "\n"
+                         "model 1 hide\n"
+                         "wait 1\n"
+                         "pick " + at(*p) + "\n"  // nothing drawn there now: clears the selection
+                         "expect-selected 0\n"
+                         "wait 1\n"
+                         "quit\n");
+  r = runViewer("--offscreen --size 320x200 --script " + pick + " " + fbl_a + " " + fbl_b);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+
+  const Tractogram last = readAllStreamlines(*openTractogram(tck_last));
+  ASSERT_EQ(last.streamlineCount(), 1u);
+  EXPECT_EQ(matches(fibers_b, last, 0).size(), 1u) << "the fiber picked at P is one of B's";
+  EXPECT_TRUE(matches(fibers_a, last, 0).empty());
+  const Tractogram only_a = readAllStreamlines(*openTractogram(tck_a));
+  ASSERT_EQ(only_a.streamlineCount(), 1u) << "one model per file";
+  EXPECT_EQ(matches(fibers_a, only_a, 0).size(), 1u) << "the fiber picked at Q is one of A's";
+  const Tractogram only_b = readAllStreamlines(*openTractogram(tck_b));
+  ASSERT_EQ(only_b.streamlineCount(), 1u);
+  EXPECT_TRUE(sameStreamline(only_b, 0, last, 0));
+
+  // The highlight is on B's fiber at P, in the frame that draws both.
+  const Png selected = readOurPng(sel_png);
+  ASSERT_EQ(selected.width, 320u);
+  // (Near P: the lit fiber's specular peak saturates towards white.)
+  size_t near_p = 0, highlighted = 0;
+  for (uint32_t y = 0; y < selected.height; ++y)
+    for (uint32_t x = 0; x < selected.width; ++x) {
+      const bool h = highlightColoured(selected, x, y);
+      highlighted += h;
+      near_p += h && std::abs(int(x) - int(p->first)) <= 3 && std::abs(int(y) - int(p->second)) <= 3;
+    }
+  EXPECT_GT(near_p, 0u) << "the fiber picked at P is highlighted";
+  EXPECT_GT(highlighted, 10u);
 }
 
 }  // namespace

@@ -44,6 +44,13 @@ struct OpenAction {  // a tractogram file to add to the model list (empty: the b
 struct CloseModelAction {  // removes a model from the list (index into ViewerState::models)
   int model = -1;
 };
+// Every visible model is drawn; the active one is the one whose statistics
+// the models panel shows (and whose raw vertices the baselines draw).
+struct ModelAction {  // index into ViewerState::models
+  enum class Op : uint8_t { Show, Hide, Activate };
+  int model = -1;
+  Op op = Op::Show;
+};
 // Picking (left click / ctrl + left click, or a script's `pick`): the fiber
 // drawn at window pixel (x, y) of the last frame (y down). A plain pick
 // makes the selection that fiber (the background clears it); `add` toggles
@@ -68,7 +75,7 @@ struct ResizeAction {  // the window (or the offscreen image) to this size in pi
 struct QuitAction {};
 
 using ViewerAction = std::variant<OrbitAction, PanAction, DollyAction, ViewAction, FovAction, SetAction,
-                                  ScreenshotAction, OpenAction, CloseModelAction, PickAction, ClearSelectionAction,
+                                  ScreenshotAction, OpenAction, CloseModelAction, ModelAction, PickAction, ClearSelectionAction,
                                   ExportSelectionAction, ExpectSelectedAction, ResizeAction, QuitAction>;
 
 // Sets one RenderSettings field from text, as `set KEY VALUE` in a script:

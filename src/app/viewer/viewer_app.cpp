@@ -37,6 +37,7 @@
 #include "render/colormap.h"
 #include "render/gpu_pick.h"
 #include "render/gpu_raw_tractogram.h"
+#include "render/gpu_scene_table.h"
 #include "render/gpu_upscale_pass.h"
 #include "render/orbit_controller.h"
 #include "render/reference_raster.h"
@@ -50,18 +51,22 @@ using Clock = std::chrono::steady_clock;
 // selected fibers and the fiber lengths read its .fbl), its fiblets on the
 // device and, once a baseline pipeline asked for them, its raw vertices.
 struct ViewerModel {
+  uint64_t id = 0;  // unique per load (the selection names models by it)
   std::unique_ptr<ModelData> data;
   GpuDataset fiblets;
   GpuRawTractogram raw;
   bool has_raw = false;
+};
 
-  // What a frame of this model draws; the per-fiber scalar of the scalar
-  // colour mode is the fiber length, already on the device with the fiblets.
-  GpuScene gpuScene() const {
-    GpuScene scene{&fiblets, has_raw ? &raw : nullptr};
-    scene.fiber_scalars = fiblets.fiberLength().address;
-    return scene;
-  }
+// What the next frame draws: every visible model's fiblets in one scene
+// (scene-global fiber ids, render/gpu_scene_table.h), or a baseline
+// pipeline's raw vertices of the active model alone.
+struct FrameScene {
+  std::vector<int> models;  // the drawn models (indices into the list), in the scene's order
+  GpuScene gpu;
+  SceneLayout layout;        // of gpu.datasets: picks map fiber ids back through it
+  RenderSettings settings;   // the state's, with a baseline not ready replaced by compute
+  bool empty() const { return models.empty(); }
 };
 
 // A reader that stops at the next chunk once `cancel` is set (a raw decode
@@ -133,11 +138,14 @@ class ViewerApp {
   void pollLoads();
   void addModel(LoadEvent& event);
   void closeModel(int model);
-  void frameActiveModel();
-  const ViewerModel* activeScene();
-  // The settings a frame of `model` is drawn with: a baseline pipeline
-  // whose raw vertices are still being decoded draws with compute meanwhile.
-  RenderSettings drawSettings(const ViewerModel& model) const;
+  // The camera on the union of the visible models (every model when none
+  // is visible), and the scalar range on their fiber lengths.
+  void frameVisibleModels();
+  void fitScalarRange();
+  // What the next frame draws (between frames: the scene's fiber lengths
+  // may be copied).
+  FrameScene currentScene();
+  uint64_t activeModelId() const;
   void ensureRawFor(int model);
   void pollRawDecode();
   void cancelRawDecode();
@@ -145,14 +153,16 @@ class ViewerApp {
   // Waits for the frame in flight and records its statistics.
   void finishFrame();
   bool drawFrame(uint32_t width, uint32_t height, double dt);
-  void recordFrame(VkCommandBuffer cmd, uint32_t width, uint32_t height, const Camera& camera);
+  void recordFrame(VkCommandBuffer cmd, uint32_t width, uint32_t height, const Camera& camera,
+                   const FrameScene& scene);
   void takeScreenshot(const ScreenshotAction& shot);
   // With --orbit: frames, mean / median / p95 wall time per frame, to stderr.
   void printFrameSummary(std::vector<double> frame_ms) const;
   // Picking and the selection (viewer_selection.h), between frames.
-  void syncSelection();
+  void syncSelection(const FrameScene& scene);
+  void syncSelection() { syncSelection(currentScene()); }
   void pickAt(const PickAction& pick);
-  GpuScene withSelection(GpuScene scene) const;
+  GpuScene withSelection(const FrameScene& scene) const;
   std::string freshScreenshotPath();
 
   ViewerOptions options_;
@@ -174,11 +184,16 @@ class ViewerApp {
   // G-buffer; null for a background-only frame).
   FrameRenderer* recorded_renderer_ = nullptr;
   std::vector<std::unique_ptr<ViewerModel>> scenes_;  // index-aligned with state_.models
-  int framed_model_ = -1;  // the model the camera was last framed on
+  uint64_t next_model_id_ = 1;
+  std::vector<uint64_t> framed_ids_;  // the models loaded when the camera was last framed
+  std::vector<uint64_t> scalar_range_ids_;  // the visible models the scalar range was fitted to
   std::unique_ptr<ViewerSelection> selection_;
-  // The dataset the G-buffer shows (the last frame drawn; null after a
-  // resize or a frame without a model): picks read it.
-  const GpuDataset* drawn_dataset_ = nullptr;
+  std::unique_ptr<GpuSceneFiberLengths> scene_lengths_;  // the scalar colour mode's per-fiber values
+  // The scene the G-buffer shows (the last frame drawn; no models after a
+  // resize or a frame without a model): picks map its fiber ids to the
+  // model ids here.
+  SceneLayout drawn_layout_;
+  std::vector<uint64_t> drawn_ids_;
   // Loading: one worker (model_loader.h); the jobs named on the command
   // line not finished yet (frames and the script count once they are).
   std::unique_ptr<ModelLoader> loader_;
@@ -254,6 +269,7 @@ void ViewerApp::createFrameObjects() {
   imgui_ = std::make_unique<ImGuiLayer>(*context_, presentation_.render_pass, window_ ? window_->handle() : nullptr);
   renderer_ = std::make_unique<FrameRenderer>(*context_, width, height);
   selection_ = std::make_unique<ViewerSelection>(*context_);
+  scene_lengths_ = std::make_unique<GpuSceneFiberLengths>(*context_);
 
   VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
   alloc.commandPool = context_->commandPool();
@@ -291,6 +307,7 @@ void ViewerApp::release() {
   upscale_ready_ = false;
   renderer_.reset();
   selection_.reset();
+  scene_lengths_.reset();
   scenes_.clear();
   destroyPresentation(*context_, presentation_);
   if (swapchain_.swapchain != VK_NULL_HANDLE) gpu::destroySwapchain(*context_, swapchain_);
@@ -357,6 +374,7 @@ void ViewerApp::addModel(LoadEvent& event) {
   finishFrame();  // the upload must not race the frame in flight
   const auto start = Clock::now();
   auto model = std::make_unique<ViewerModel>();
+  model->id = next_model_id_++;
   model->fiblets = GpuDataset::upload(*context_, data.fbl);
   const double upload_seconds = std::chrono::duration<double>(Clock::now() - start).count();
 
@@ -378,7 +396,8 @@ void ViewerApp::addModel(LoadEvent& event) {
   model->data = std::move(event.model);
   state_.models.push_back(info);
   scenes_.push_back(std::move(model));
-  state_.active_model = int(state_.models.size()) - 1;  // framed by the next drawFrame
+  state_.active_model = int(state_.models.size()) - 1;  // the camera framed on every model by the next drawFrame
+  scene_lengths_->invalidate();
 
   uint64_t frames_meanwhile = 0;
   for (auto it = job_first_frame_.begin(); it != job_first_frame_.end(); ++it)
@@ -416,24 +435,54 @@ void ViewerApp::closeModel(int model) {
   };
   const bool was_active = state_.active_model == model;
   shift(state_.active_model);
-  shift(framed_model_);
+  scene_lengths_->invalidate();
+  drawn_layout_ = {};  // the G-buffer may show the closed model: no picks until the next frame
+  drawn_ids_.clear();
   // The next model takes the closed one's place (framed by the next drawFrame).
   if (was_active && !state_.models.empty()) state_.active_model = std::min(model, int(state_.models.size()) - 1);
 }
 
-void ViewerApp::frameActiveModel() {
-  if (state_.active_model < 0) return;
-  const ModelData& data = *scenes_[size_t(state_.active_model)]->data;
-  controller_.frame(data.bounds, data.sample);
-  framed_model_ = state_.active_model;
-  // The scalar colour mode's range follows the model shown: its fibers'
-  // lengths.
+void ViewerApp::frameVisibleModels() {
+  framed_ids_.clear();
+  for (const auto& m : scenes_) framed_ids_.push_back(m->id);
+  bool any_visible = false;
+  for (const ModelInfo& m : state_.models) any_visible |= m.visible;
+  Bounds bounds;
+  std::vector<Vec3d> sample;
+  bool first = true;
+  for (size_t i = 0; i < scenes_.size(); ++i) {
+    if (any_visible && !state_.models[i].visible) continue;
+    const ModelData& data = *scenes_[i]->data;
+    for (int k = 0; k < 3; ++k) {
+      bounds.min[k] = first ? data.bounds.min[k] : std::min(bounds.min[k], data.bounds.min[k]);
+      bounds.max[k] = first ? data.bounds.max[k] : std::max(bounds.max[k], data.bounds.max[k]);
+    }
+    first = false;
+    sample.insert(sample.end(), data.sample.begin(), data.sample.end());
+  }
+  if (!first) controller_.frame(bounds, sample);
+}
+
+void ViewerApp::fitScalarRange() {
+  // The scalar colour mode's range follows the models shown: their fibers'
+  // lengths (one colormap over the scene, so models compare).
+  scalar_range_ids_.clear();
   state_.scalar_data_min = 1, state_.scalar_data_max = 0;
-  if (const FblSection* section = data.fbl.find(kFblSectionFiberLength)) {
-    try {
-      finiteRange(data.fbl.array<float>(*section), state_.scalar_data_min, state_.scalar_data_max);
-    } catch (const Error& e) {
-      state_.status = e.what();
+  for (size_t i = 0; i < scenes_.size(); ++i) {
+    if (!state_.models[i].visible) continue;
+    scalar_range_ids_.push_back(scenes_[i]->id);
+    const ModelData& data = *scenes_[i]->data;
+    if (const FblSection* section = data.fbl.find(kFblSectionFiberLength)) {
+      try {
+        float lo = 1, hi = 0;
+        finiteRange(data.fbl.array<float>(*section), lo, hi);
+        if (lo > hi) continue;
+        const bool none_yet = state_.scalar_data_min > state_.scalar_data_max;
+        state_.scalar_data_min = none_yet ? lo : std::min(state_.scalar_data_min, lo);
+        state_.scalar_data_max = none_yet ? hi : std::max(state_.scalar_data_max, hi);
+      } catch (const Error& e) {
+        state_.status = e.what();
+      }
     }
   }
   if (!options_.keep_scalar_range && state_.scalar_data_min <= state_.scalar_data_max) {
@@ -442,16 +491,63 @@ void ViewerApp::frameActiveModel() {
   }
 }
 
-const ViewerModel* ViewerApp::activeScene() {
+uint64_t ViewerApp::activeModelId() const {
   const int m = state_.active_model;
-  if (m < 0 || m >= int(scenes_.size()) || !state_.models[size_t(m)].visible) return nullptr;
-  return scenes_[size_t(m)].get();
+  return m >= 0 && m < int(scenes_.size()) ? scenes_[size_t(m)]->id : 0;
 }
 
-RenderSettings ViewerApp::drawSettings(const ViewerModel& model) const {
-  RenderSettings settings = state_.settings;
-  if (settings.pipeline != RenderPipeline::Compute && !model.has_raw) settings.pipeline = RenderPipeline::Compute;
-  return settings;
+FrameScene ViewerApp::currentScene() {
+  FrameScene scene;
+  scene.settings = state_.settings;
+  state_.baseline_draws_active_only = false;
+  const int active = state_.active_model;
+  const bool active_shown = active >= 0 && active < int(scenes_.size()) && state_.models[size_t(active)].visible;
+  if (scene.settings.pipeline != RenderPipeline::Compute) {
+    // The baselines draw one raw tractogram: the active model's, once its
+    // raw vertices are decoded (compute meanwhile, over every visible model).
+    if (active_shown && scenes_[size_t(active)]->has_raw) {
+      const ViewerModel& model = *scenes_[size_t(active)];
+      scene.models = {active};
+      scene.gpu = GpuScene{&model.fiblets, &model.raw};
+      scene.layout = sceneLayout(scene.gpu.datasets);
+      scene.gpu.fiber_scalars = model.fiblets.fiberLength().address;
+      int visible = 0;
+      for (const ModelInfo& m : state_.models) visible += m.visible;
+      state_.baseline_draws_active_only = visible > 1;
+      return scene;
+    }
+    scene.settings.pipeline = RenderPipeline::Compute;
+  }
+  for (size_t i = 0; i < scenes_.size(); ++i) {
+    if (!state_.models[i].visible) continue;
+    scene.models.push_back(int(i));
+    scene.gpu.datasets.push_back(&scenes_[i]->fiblets);
+  }
+  try {
+    scene.layout = sceneLayout(scene.gpu.datasets);
+  } catch (const Error& e) {
+    // Too many fiblets for one frame's keys: the active model alone (or
+    // nothing), and the reason in the status line.
+    state_.status = e.what();
+    scene.models.clear();
+    scene.gpu.datasets.clear();
+    if (active_shown) {
+      scene.models = {active};
+      scene.gpu.datasets = {&scenes_[size_t(active)]->fiblets};
+    }
+    scene.layout = sceneLayout(scene.gpu.datasets);
+  }
+  // The scene's fiber lengths for the scalar colour mode (one dataset: its
+  // own buffer; several: concatenated once per scene).
+  if (scene.settings.color == ColorMode::Scalar && !scene.empty()) {
+    try {
+      finishFrame();  // a new concatenation may replace a buffer a frame reads
+      scene.gpu.fiber_scalars = scene_lengths_->update(scene.layout);
+    } catch (const Error& e) {
+      state_.status = e.what();
+    }
+  }
+  return scene;
 }
 
 // The baselines draw raw vertices, decoded when such a pipeline is first
@@ -538,6 +634,16 @@ void ViewerApp::apply(const ViewerAction& action) {
           openModel(a.path);  // on the worker: framed when it is added
         } else if constexpr (std::is_same_v<A, CloseModelAction>) {
           closeModel(a.model);
+        } else if constexpr (std::is_same_v<A, ModelAction>) {
+          if (a.model < 0 || a.model >= int(state_.models.size())) {
+            state_.status = "model " + std::to_string(a.model) + ": no such model (" +
+                            std::to_string(state_.models.size()) + " loaded)";
+            std::fprintf(stderr, "fibscope view: %s\n", state_.status.c_str());
+          } else if (a.op == ModelAction::Op::Activate) {
+            state_.active_model = a.model;
+          } else {
+            state_.models[size_t(a.model)].visible = a.op == ModelAction::Op::Show;
+          }
         } else if constexpr (std::is_same_v<A, PickAction>) {
           pickAt(a);
         } else if constexpr (std::is_same_v<A, ClearSelectionAction>) {
@@ -546,8 +652,11 @@ void ViewerApp::apply(const ViewerAction& action) {
         } else if constexpr (std::is_same_v<A, ExportSelectionAction>) {
           try {
             syncSelection();  // a model closed meanwhile takes its selection with it
-            selection_->exportTck(a.path);
-            state_.status = "exported " + std::to_string(selection_->size()) + " fibers to " + a.path;
+            const ViewerSelection::Exported done = selection_->exportTck(a.path);
+            state_.status = "exported " + std::to_string(done.written) + " fibers of " + done.model + " to " + a.path;
+            if (done.left_out > 0)
+              state_.status += " (" + std::to_string(done.left_out) +
+                               " selected fibers of other models not written: one model per file)";
           } catch (const Error& e) {
             state_.status = e.what();
             std::fprintf(stderr, "fibscope view: %s\n", e.what());
@@ -581,13 +690,13 @@ void ViewerApp::takeScreenshot(const ScreenshotAction& shot) {
   try {
     finishFrame();
     controller_.finishAnimation();
-    const ViewerModel* scene = activeScene();
-    if (!scene) throw Error("screenshot: no visible model to draw");
+    const FrameScene scene = currentScene();
+    if (scene.empty()) throw Error("screenshot: no visible model to draw");
     if (!shot_renderer_) shot_renderer_ = std::make_unique<FrameRenderer>(*context_, shot.width, shot.height);
     shot_renderer_->resize(shot.width, shot.height);
     const Camera camera = controller_.camera(shot.width, shot.height);
-    syncSelection();
-    shot_renderer_->render(camera, drawSettings(*scene), withSelection(scene->gpuScene()));
+    syncSelection(scene);
+    shot_renderer_->render(camera, scene.settings, withSelection(scene));
     writePngRgba(path, shot.width, shot.height, downloadColor(*context_, shot_renderer_->targets()));
     controller_.setViewport(presentation_.width, presentation_.height);  // camera() noted the shot's size
     state_.status = "saved " + path;
@@ -597,19 +706,25 @@ void ViewerApp::takeScreenshot(const ScreenshotAction& shot) {
   }
 }
 
-void ViewerApp::syncSelection() {
-  // The selection belongs to the active model, shown or hidden.
-  SelectionSource source;
-  const int m = state_.active_model;
-  if (m >= 0 && m < int(scenes_.size()) && scenes_[size_t(m)]) {
-    const ViewerModel& model = *scenes_[size_t(m)];
-    source.dataset = &model.fiblets;
-    source.fbl = &model.data->fbl;
-    source.path = model.data->source_path;
+void ViewerApp::syncSelection(const FrameScene& scene) {
+  // Every loaded model may hold selected fibers; those drawn in `scene`
+  // are highlighted at their scene-global ids.
+  std::vector<SelectionModel> models;
+  for (size_t i = 0; i < scenes_.size(); ++i) {
+    const ViewerModel& model = *scenes_[i];
+    SelectionModel m;
+    m.id = model.id;
+    m.name = model.data->name;
+    m.dataset = &model.fiblets;
+    m.fbl = &model.data->fbl;
+    m.path = model.data->source_path;
+    for (size_t k = 0; k < scene.models.size(); ++k)
+      if (scene.models[k] == int(i)) m.fiber_base = scene.layout.entries[k].fiber_base;
+    models.push_back(std::move(m));
   }
   try {
     finishFrame();  // uploads wait for the queue; the frame in flight reads the bits
-    selection_->sync(source, state_.selection);
+    selection_->sync(models, scene.layout.fibers, activeModelId(), state_.selection);
   } catch (const Error& e) {
     state_.status = e.what();
   }
@@ -618,31 +733,44 @@ void ViewerApp::syncSelection() {
 void ViewerApp::pickAt(const PickAction& pick) {
   try {
     finishFrame();
-    PickResult result;  // no hit
-    // The G-buffer holds the last frame drawn: it answers for that model only.
-    if (drawn_dataset_ && drawn_dataset_ == selection_->dataset() && pick.x >= 0 && pick.y >= 0 &&
-        pick.x < presentation_.width && pick.y < presentation_.height) {
+    // The G-buffer holds the last frame drawn: its scene-global fiber ids
+    // map to (model, fiber) through that frame's layout.
+    std::optional<SelectedEntry> hit;
+    std::string what = "no fiber there: ";
+    if (!drawn_ids_.empty() && pick.x >= 0 && pick.y >= 0 && pick.x < presentation_.width &&
+        pick.y < presentation_.height) {
       // The G-buffer of the renderer that drew it (a coarse frame's is
       // smaller): window pixels scaled to its size.
       const GpuFrameTargets& drawn = (recorded_renderer_ ? recorded_renderer_ : renderer_.get())->targets();
-      result = pickFiber(*context_, drawn, uint32_t(uint64_t(pick.x) * drawn.width / presentation_.width),
-                         uint32_t(uint64_t(pick.y) * drawn.height / presentation_.height));
+      const PickResult result =
+          pickFiber(*context_, drawn, uint32_t(uint64_t(pick.x) * drawn.width / presentation_.width),
+                    uint32_t(uint64_t(pick.y) * drawn.height / presentation_.height));
+      if (result.hit) {
+        if (const std::optional<SceneFiber> at = locateSceneFiber(drawn_layout_, result.fiber)) {
+          hit = SelectedEntry{drawn_ids_[at->dataset], at->fiber};
+          what = "fiber " + std::to_string(at->fiber) + " of ";
+          for (const auto& m : scenes_)
+            if (m->id == hit->model) what += m->data->name;
+          what += ": ";
+        }
+      }
     }
-    selection_->pick(result, pick.add);
+    syncSelection();  // knows the models the hit may name
+    selection_->pick(hit, pick.add);
     syncSelection();
     const size_t n = selection_->size();
-    state_.status = (result.hit ? "fiber " + std::to_string(result.fiber) + ": " : std::string("no fiber there: ")) +
-                    std::to_string(n) + (n == 1 ? " fiber" : " fibers") + " selected";
+    state_.status = what + std::to_string(n) + (n == 1 ? " fiber" : " fibers") + " selected";
   } catch (const Error& e) {
     state_.status = e.what();
     std::fprintf(stderr, "fibscope view: %s\n", e.what());
   }
 }
 
-GpuScene ViewerApp::withSelection(GpuScene scene) const {
-  // The bits are sized for the selection's dataset: never for another one.
-  if (scene.datasets.size() == 1 && scene.datasets[0] == selection_->dataset()) scene.selection_bits = selection_->bits();
-  return scene;
+GpuScene ViewerApp::withSelection(const FrameScene& scene) const {
+  // The bits were uploaded for this scene's numbering by syncSelection(scene).
+  GpuScene gpu = scene.gpu;
+  gpu.selection_bits = selection_->bits();
+  return gpu;
 }
 
 void ViewerApp::finishFrame() {
@@ -664,7 +792,8 @@ void ViewerApp::resizeTo(uint32_t width, uint32_t height) {
   finishFrame();
   vkDeviceWaitIdle(context_->device());
   renderer_->resize(width, height);
-  drawn_dataset_ = nullptr;  // the G-buffer is new: nothing to pick until a frame is drawn
+  drawn_layout_ = {};  // the G-buffer is new: nothing to pick until a frame is drawn
+  drawn_ids_.clear();
   resizePresentation(*context_, presentation_, width, height);
   if (window_) {
     gpu::recreateSwapchain(*context_, swapchain_, width, height);
@@ -672,13 +801,14 @@ void ViewerApp::resizeTo(uint32_t width, uint32_t height) {
   }
 }
 
-void ViewerApp::recordFrame(VkCommandBuffer cmd, uint32_t width, uint32_t height, const Camera& camera) {
-  const ViewerModel* scene = activeScene();
-  drawn_dataset_ = nullptr;
+void ViewerApp::recordFrame(VkCommandBuffer cmd, uint32_t width, uint32_t height, const Camera& camera,
+                            const FrameScene& scene) {
+  drawn_layout_ = {};
+  drawn_ids_.clear();
   frame_coarse_ = false;
   recorded_renderer_ = nullptr;
-  if (scene) {
-    RenderSettings settings = drawSettings(*scene);
+  if (!scene.empty()) {
+    RenderSettings settings = scene.settings;
     // Adaptive detail (adaptive_detail.h). Moving: the camera differs from
     // the last frame's (slow frames settle the controller's smoothing within
     // one update, so animating() alone would miss a steady orbit).
@@ -702,16 +832,17 @@ void ViewerApp::recordFrame(VkCommandBuffer cmd, uint32_t width, uint32_t height
       Camera half = camera;
       half.width = half_width;
       half.height = half_height;
-      coarse_renderer_->record(cmd, half, settings, withSelection(scene->gpuScene()));
+      coarse_renderer_->record(cmd, half, settings, withSelection(scene));
       gpu::computeToComputeBarrier(cmd);
       recordUpscale(cmd, upscale_, coarse_renderer_->targets().color, half_width, half_height,
                     renderer_->targets().color, width, height);
       recorded_renderer_ = coarse_renderer_.get();
     } else {
-      renderer_->record(cmd, camera, settings, withSelection(scene->gpuScene()));
+      renderer_->record(cmd, camera, settings, withSelection(scene));
       recorded_renderer_ = renderer_.get();
     }
-    drawn_dataset_ = &scene->fiblets;
+    drawn_layout_ = scene.layout;
+    for (const int m : scene.models) drawn_ids_.push_back(scenes_[size_t(m)]->id);
   } else {
     // Nothing to draw: the background alone (RGBA8, R in the low byte).
     auto byte = [](float v) { return uint32_t(std::clamp(v, 0.0f, 1.0f) * 255.0f + 0.5f); };
@@ -747,18 +878,28 @@ bool ViewerApp::drawFrame(uint32_t width, uint32_t height, double dt) {
 
   imgui_->newFrame(width, height, dt);
   for (const ViewerAction& action : drawViewerUi(state_)) apply(action);
-  if (state_.active_model != framed_model_) frameActiveModel();
+  // A model added or closed: the camera frames every visible model. Show,
+  // hide and switching the active model keep the view (the user may hide a
+  // model to look inside another).
+  std::vector<uint64_t> ids, visible_ids;
+  for (size_t i = 0; i < scenes_.size(); ++i) {
+    ids.push_back(scenes_[i]->id);
+    if (state_.models[i].visible) visible_ids.push_back(scenes_[i]->id);
+  }
+  if (ids != framed_ids_) frameVisibleModels();
+  if (visible_ids != scalar_range_ids_) fitScalarRange();
   ensureRawFor(state_.active_model);
   if (state_.fov_deg != controller_.fovY()) controller_.setFovY(state_.fov_deg);
   const Camera camera = controller_.camera(width, height);
-  syncSelection();  // the highlight's bits for this frame (nothing in flight now)
+  const FrameScene scene = currentScene();
+  syncSelection(scene);  // the highlight's bits for this frame (nothing in flight now)
 
   VK_CHECK(vkResetCommandBuffer(cmd_, 0));
   VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   VK_CHECK(vkBeginCommandBuffer(cmd_, &begin));
   try {
-    recordFrame(cmd_, width, height, camera);
+    recordFrame(cmd_, width, height, camera, scene);
   } catch (const Error& e) {
     // Settings the renderer refuses: show why, draw with the defaults next.
     VK_CHECK(vkEndCommandBuffer(cmd_));

@@ -98,6 +98,19 @@ std::variant<ViewerAction, WaitFrames, WaitLoaded> parseCommand(const std::vecto
       throw Error("pick: expected 'add' or nothing after X Y, got '" + std::string(w[3]) + "'");
     return ViewerAction{PickAction{x, y, w.size() == 4}};
   }
+  if (name == "model") {
+    expectArguments(w, 2, 2, "model N show|hide|activate");
+    const double n = number(w[1], "N");
+    if (!(n >= 0 && n < 65536) || n != std::floor(n))
+      throw Error("model: expected a model index from 0 (the first opened), got " + std::string(w[1]));
+    ModelAction action;
+    action.model = int(n);
+    if (w[2] == "show") action.op = ModelAction::Op::Show;
+    else if (w[2] == "hide") action.op = ModelAction::Op::Hide;
+    else if (w[2] == "activate") action.op = ModelAction::Op::Activate;
+    else throw Error("model: expected show, hide or activate, got '" + std::string(w[2]) + "'");
+    return ViewerAction{action};
+  }
   if (name == "clear-selection") {
     expectArguments(w, 0, 0, "clear-selection");
     return ViewerAction{ClearSelectionAction{}};
@@ -129,8 +142,8 @@ std::variant<ViewerAction, WaitFrames, WaitLoaded> parseCommand(const std::vecto
     return ViewerAction{QuitAction{}};
   }
   throw Error("unknown command '" + std::string(name) +
-              "' (expected orbit, pan, dolly, view, fov, set, wait, wait-loaded, open, screenshot, pick, "
-              "clear-selection, export-selection, expect-selected, resize or quit)");
+              "' (expected orbit, pan, dolly, view, fov, set, wait, wait-loaded, open, model, screenshot, "
+              "pick, clear-selection, export-selection, expect-selected, resize or quit)");
 }
 
 }  // namespace

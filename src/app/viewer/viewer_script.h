@@ -10,9 +10,10 @@
 //   screenshot OUT.png [WxH]    (WxH: the scene alone at that size)
 //   open PATH                   (loads on the worker; frames go on meanwhile)
 //   wait-loaded                 (holds until no load is queued or running)
+//   model N show|hide|activate  (model N of the list, 0 = the first opened)
 //   pick X Y [add]              (window pixels of the last frame; add: ctrl-click)
 //   clear-selection
-//   export-selection OUT.tck    (the selected fibers of the active model)
+//   export-selection OUT.tck    (the selected fibers of one model: ViewerSelection::exportTck)
 //   expect-selected N           (the run fails naming the line unless N are selected)
 //   resize W H                 (the window, or the offscreen image, in pixels)
 //   quit

@@ -1,86 +1,115 @@
-// The viewer's fiber selection on the GPU side: the FiberSelection of the
-// model being drawn, its bit words in a GpuFiberAttributes buffer for the
-// highlight (GpuScene::selection_bits), the lengths of the selected fibers
-// for the selection panel, and the export of the selection to a .tck.
+// The viewer's fiber selection on the GPU side: fibers of any loaded model
+// as (model, fiber) pairs, their bits in a GpuFiberAttributes buffer for
+// the highlight (GpuScene::selection_bits, over the scene-global fiber ids
+// of the models drawn), the lengths of the selected fibers for the
+// selection panel, and the export of the selection to a .tck.
 //
-// Fiber ids are the G-buffer's, so a selection belongs to one dataset: when
-// the drawn model changes (another model made active, a model reloaded or
-// closed) the selection is cleared. Every call that touches the GPU (sync)
-// runs between frames, after the frame's fence.
+// Several models are drawn in one frame with scene-global fiber ids
+// (render/gpu_scene_table.h), so a selection entry names its model by the
+// viewer's model id (unique per load: a reloaded file is a new model) and
+// the fiber within it. A closed model takes its entries with it; a hidden
+// one keeps them (not highlighted while hidden). Every call that touches
+// the GPU (sync) runs between frames, after the frame's fence.
 #pragma once
 
 #include <vulkan/vulkan.h>
 
 #include <cstdint>
+#include <map>
 #include <optional>
+#include <span>
 #include <string>
+#include <vector>
 
 #include "app/viewer/viewer_state.h"
 #include "codec/fbl_file.h"
 #include "gpu/vulkan_context.h"
-#include "render/fiber_selection.h"
 #include "render/gpu_dataset.h"
 #include "render/gpu_fiber_attributes.h"
-#include "render/gpu_pick.h"
 
 namespace fibscope {
 
-// The model a selection refers to.
-struct SelectionSource {
-  const GpuDataset* dataset = nullptr;  // null: no model (the selection is cleared)
+// A model the selection may refer to.
+struct SelectionModel {
+  uint64_t id = 0;  // the viewer's model id
+  std::string name;
+  const GpuDataset* dataset = nullptr;
   // The model's opened .fbl (export, lengths); null when not in reach.
   const FblFile* fbl = nullptr;
   // The model's file: when `fbl` is null and this is a .fbl, it is opened
   // here (once per model) for export and lengths.
   std::string path;
+  // Its first fiber in the scene the next frames draw; nullopt: not drawn
+  // (hidden).
+  std::optional<uint32_t> fiber_base;
+};
+
+struct SelectedEntry {
+  uint64_t model = 0;  // SelectionModel::id
+  uint32_t fiber = 0;  // within the model
+  bool operator==(const SelectedEntry&) const = default;
 };
 
 class ViewerSelection {
  public:
   explicit ViewerSelection(const gpu::VulkanContext& context) : context_(&context) {}
 
-  // Between frames (no frame in flight): follows `source` (a different
-  // dataset than the last one clears the selection and its buffer), uploads
-  // the bit words when the selection changed since the last upload, and
-  // refreshes `info` (the panel's list with lengths). Errors from the GPU
-  // (memory) propagate as Error.
-  void sync(const SelectionSource& source, SelectionInfo& info);
+  // Between frames (no frame in flight): follows the loaded `models` (the
+  // entries of a model no longer listed are dropped), uploads the bit
+  // words over `scene_fibers` scene-global fibers when the selection or the
+  // drawn scene changed since the last upload, and refreshes `info` (the
+  // panel's list with model names and lengths). `active` (an id, or 0)
+  // picks the model an export writes. Errors from the GPU (memory)
+  // propagate as Error.
+  void sync(std::span<const SelectionModel> models, uint32_t scene_fibers, uint64_t active, SelectionInfo& info);
 
-  // For GpuScene::selection_bits of the synced dataset's frames: 0 when
-  // nothing is selected (nothing dimmed).
+  // For GpuScene::selection_bits of the synced scene's frames: 0 when no
+  // drawn fiber is selected (nothing dimmed).
   VkDeviceAddress bits() const { return attributes_ ? attributes_->selection() : 0; }
-  // The dataset of the last sync (what picks refer to).
-  const GpuDataset* dataset() const { return dataset_; }
 
-  // A click: a plain one selects the hit fiber (the background clears the
-  // selection), an added one (ctrl) toggles the hit fiber (the background
-  // changes nothing).
-  void pick(const PickResult& result, bool add);
-  void clear() { selection_.clear(); }
-  size_t size() const { return selection_.size(); }
-  const FiberSelection& selection() const { return selection_; }
+  // A click on fiber `fiber` of model `model` (nullopt: the background): a
+  // plain one selects the fiber (the background clears the selection), an
+  // added one (ctrl) toggles it (the background changes nothing).
+  void pick(std::optional<SelectedEntry> hit, bool add);
+  void clear();
+  size_t size() const { return entries_.size(); }
+  const std::vector<SelectedEntry>& entries() const { return entries_; }  // in selection order
 
-  // Writes the selected fibers (in selection order) to `tck_path` from the
-  // model's .fbl. Throws Error (one line) when nothing is selected, the
-  // .fbl is not in reach, or exportFibers fails.
-  void exportTck(const std::string& tck_path) const;
+  // Writes the selected fibers of ONE model (in selection order) to
+  // `tck_path` from its .fbl: the active model's when it has selected
+  // fibers, else the model of the fiber selected last (the models' points
+  // may not share a space or header, so no file mixes them). Returns that
+  // model's name and how many selected fibers of other models were left
+  // out. Throws Error (one line) when nothing is selected, the .fbl is not
+  // in reach, or exportFibers fails.
+  struct Exported {
+    std::string model;
+    size_t written = 0, left_out = 0;
+  };
+  Exported exportTck(const std::string& tck_path) const;
 
  private:
-  const FblFile* fbl() const;
-  std::optional<float> lengthMm(uint32_t fiber) const;
+  // Per model: its source, and the .fbl opened from its path when needed.
+  struct Known {
+    SelectionModel source;
+    std::optional<FblFile> opened;  // from source.path
+    std::string fbl_error;          // why the .fbl is not in reach
+    const FblFile* fbl() const { return source.fbl ? source.fbl : (opened ? &*opened : nullptr); }
+  };
+  std::optional<float> lengthMm(const Known& model, uint32_t fiber) const;
 
   const gpu::VulkanContext* context_;
-  FiberSelection selection_;
-  const GpuDataset* dataset_ = nullptr;
-  VkDeviceAddress dataset_address_ = 0;  // with the pointer: a reloaded model at a reused address is still new
-  uint64_t fiber_count_ = 0;
+  std::vector<SelectedEntry> entries_;
+  uint64_t revision_ = 1;  // changes with every modification
+  std::map<uint64_t, Known> models_;
+  uint64_t active_ = 0;
   std::optional<GpuFiberAttributes> attributes_;
+  // What the uploaded bits describe: the revision and each drawn model's
+  // base; and what the panel lists.
   std::optional<uint64_t> uploaded_revision_;
+  std::vector<std::pair<uint64_t, uint32_t>> uploaded_bases_;
+  uint32_t uploaded_fibers_ = 0;
   std::optional<uint64_t> listed_revision_;
-  const FblFile* source_fbl_ = nullptr;
-  std::string opened_path_;             // the .fbl opened from SelectionSource::path
-  std::optional<FblFile> opened_fbl_;   // null when it could not be opened
-  std::string fbl_error_;               // why the .fbl is not in reach
 };
 
 }  // namespace fibscope

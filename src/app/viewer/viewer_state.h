@@ -56,16 +56,17 @@ struct FrameRecord {
   FrameStats gpu;       // passes, GPU time, fiblets drawn
 };
 
-// The active model's fiber selection, for the selection panel
+// The fiber selection (fibers of any model), for the selection panel
 // (viewer_ui_selection.cpp); the frame loop fills it from its
 // ViewerSelection after each change.
 struct SelectedFiber {
+  std::string model;               // the model's name
   uint32_t fiber = 0;              // streamline index in the model
   std::optional<float> length_mm;  // nullopt: no length in reach
 };
 struct SelectionInfo {
   std::vector<SelectedFiber> fibers;  // in selection order
-  bool exportable = false;            // the model's .fbl is in reach
+  bool exportable = false;            // a selected model's .fbl is in reach
   std::string export_path = "selection.tck";
 };
 
@@ -88,7 +89,11 @@ struct ViewerState {
   std::vector<LoadingInfo> loading;  // the running job first; empty when idle
   std::vector<LoadFailure> load_failures;
   std::vector<std::string> recent_files;  // newest first (recent_files.h)
-  SelectionInfo selection;  // of the active model
+  SelectionInfo selection;
+  // Every visible model is drawn; with a baseline pipeline (lines,
+  // raw-compute: one tractogram) only the active one, which the status of
+  // the settings panel then says.
+  bool baseline_draws_active_only = false;
 
   // Newest last, at most kFrameHistory.
   static constexpr size_t kFrameHistory = 240;

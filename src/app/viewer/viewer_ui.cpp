@@ -38,6 +38,9 @@ void settingsPanel(ViewerState& state, std::vector<ViewerAction>& actions) {
   }
   RenderSettings& s = state.settings;
   enumCombo("pipeline", s.pipeline, 3, renderPipelineName);
+  if (state.baseline_draws_active_only)
+    ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "%s draws the active model only",
+                       std::string(renderPipelineName(s.pipeline)).c_str());
   if (s.pipeline == RenderPipeline::Compute) enumCombo("culling", s.culling, 3, cullingModeName);
   if (s.pipeline == RenderPipeline::Compute && s.culling != CullingMode::None)
     ImGui::SliderFloat("LoD below", &s.lod_pixels, 0.0f, 16.0f, "%.1f px");

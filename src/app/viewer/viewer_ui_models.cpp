@@ -110,15 +110,16 @@ void modelList(ViewerState& state, std::vector<ViewerAction>& actions) {
     ModelInfo& m = state.models[size_t(i)];
     ImGui::PushID(i);
     ImGui::Checkbox("##visible", &m.visible);
-    if (ImGui::IsItemHovered()) ImGui::SetTooltip("Show or hide (only the active model is drawn)");
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("Show or hide: every visible model is drawn");
     ImGui::SameLine();
     if (ImGui::SmallButton("x")) actions.push_back(CloseModelAction{i});
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("Close this model");
     ImGui::SameLine();
     if (ImGui::Selectable(m.name.c_str(), state.active_model == i)) state.active_model = i;
     if (ImGui::IsItemHovered())
-      ImGui::SetTooltip("%s\nClick to make it the active model: the renderer draws one model at a time, the "
-                        "active one, when it is visible.",
+      ImGui::SetTooltip("%s\nClick to make it the active model: its statistics below, the scalar range's fit, "
+                        "the export of selected fibers, and the model the baseline pipelines (lines, raw-compute) "
+                        "draw alone.",
                         m.path.empty() ? "the built-in phantom" : m.path.c_str());
     ImGui::PopID();
   }

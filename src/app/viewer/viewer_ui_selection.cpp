@@ -35,11 +35,12 @@ void drawSelectionPanel(ViewerState& state, std::vector<ViewerAction>& actions) 
   // visible rows of a long selection.
   const float row = ImGui::GetTextLineHeightWithSpacing();
   const float height = row * float(std::min<size_t>(n, 8) + 1) + 4;
-  if (ImGui::BeginTable("fibers", 2,
+  if (ImGui::BeginTable("fibers", 3,
                         ImGuiTableFlags_ScrollY | ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersOuter |
                             ImGuiTableFlags_SizingStretchSame,
                         ImVec2(0, height))) {
     ImGui::TableSetupScrollFreeze(0, 1);
+    ImGui::TableSetupColumn("model");
     ImGui::TableSetupColumn("fiber");
     ImGui::TableSetupColumn("length");
     ImGui::TableHeadersRow();
@@ -49,6 +50,8 @@ void drawSelectionPanel(ViewerState& state, std::vector<ViewerAction>& actions) 
       for (int i = clipper.DisplayStart; i < clipper.DisplayEnd; ++i) {
         const SelectedFiber& f = selection.fibers[size_t(i)];
         ImGui::TableNextRow();
+        ImGui::TableNextColumn();
+        ImGui::TextUnformatted(f.model.c_str());
         ImGui::TableNextColumn();
         ImGui::Text("%u", f.fiber);
         ImGui::TableNextColumn();
@@ -65,10 +68,13 @@ void drawSelectionPanel(ViewerState& state, std::vector<ViewerAction>& actions) 
   if (!selection.exportable) ImGui::BeginDisabled();
   if (ImGui::Button("Export .tck") && !selection.export_path.empty())
     actions.push_back(ExportSelectionAction{selection.export_path});
+  if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+    ImGui::SetTooltip("Writes the selected fibers of one model: the active model's, or the model of the fiber "
+                      "selected last when the active one has none");
   if (!selection.exportable) {
     ImGui::EndDisabled();
     ImGui::SameLine();
-    ImGui::TextDisabled("(the model's .fbl is not ready)");
+    ImGui::TextDisabled("(the models' .fbl is not ready)");
   }
 
   ImGui::Separator();
