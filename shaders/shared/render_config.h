@@ -8,15 +8,20 @@
 //                floatBitsToUint(1.0) = 0x3F800000 < 2^30, so the depth fits
 //                in 30 bits WITHOUT rounding: nearer is smaller.
 //   bits 33..0   payload, 34 bits, pipeline-specific:
-//                compute:     fiblet << 6 | segment within the fiblet
-//                             (2^28 = 268 M fiblets, 64 segments: the paper's
-//                             10 M fibers / 140 M fiblets fit);
+//                compute:     fiblet << 6 | segment within the fiblet,
+//                             the fiblet numbered over every dataset of the
+//                             frame (shared/scene_table.h: the models drawn
+//                             together share the 2^28 = 268 M fiblets; 64
+//                             segments: the paper's 10 M fibers / 140 M
+//                             fiblets fit);
 //                raw-compute: the global index of the segment's first point
 //                             (2^34 = 17 G points; the paper's largest is 8.1 G).
 //   kEmptyKey (all ones) is larger than every drawn key.
 // Equal depths resolve to the smaller payload; fiblets are stored in fiber
-// order and points in order within a fiblet, so that is the smaller (fiber,
-// point) pair, as in the CPU reference (src/render/reference_raster.h).
+// order and points in order within a fiblet (and datasets follow each other
+// in the scene's numbering), so that is the smaller (fiber, point) pair, as
+// in the CPU reference (src/render/reference_raster.h) of the datasets'
+// union.
 #ifndef FIBSCOPE_SHADERS_SHARED_RENDER_CONFIG_H
 #define FIBSCOPE_SHADERS_SHARED_RENDER_CONFIG_H
 
