@@ -342,6 +342,17 @@ void FibletEncoder::encode(const Tractogram& chunk, EncodedFiblets& out) {
   }
   for (size_t l = 0; l < kLanes; ++l)
     while (lanes_[l].active) advance(l);
+  // Room for the whole chunk first (growing geometrically where encode is
+  // called again on the same output): appending record by record grew the
+  // bytes by doubling, copying them each time.
+  size_t fiblets = 0;
+  for (const Placement& p : placements_) fiblets += p.fiblets;
+  const auto makeRoom = [](auto& v, size_t more) {
+    if (v.capacity() < v.size() + more) v.reserve(std::max(v.size() + more, 2 * v.capacity()));
+  };
+  makeRoom(out.bytes, fiblets * params_.recordBytes());
+  makeRoom(out.fiber_first_fiblet, fibers);
+  makeRoom(out.fiber_points, fibers);
   for (size_t s = 0; s < fibers; ++s) {
     const Placement& p = placements_[s];
     emit(lanes_[p.lane], p.offset, p.fiblets, uint32_t(chunk.pointsIn(s)), out);
