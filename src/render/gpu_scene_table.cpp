@@ -16,7 +16,8 @@ SceneLayout sceneLayout(std::span<const GpuDataset* const> datasets) {
   SceneLayout layout;
   uint64_t fiblets = 0, fibers = 0;
   for (const GpuDataset* dataset : datasets) {
-    layout.entries.push_back({dataset, uint32_t(fiblets), uint32_t(fibers)});
+    layout.entries.push_back({dataset, uint32_t(fiblets), uint32_t(fibers), dataset->blockAddress(),
+                              dataset->block().fiblet_count, dataset->block().fiber_count});
     fiblets += dataset->block().fiblet_count;
     fibers += dataset->block().fiber_count;
     // Checked per step: the bases of the next dataset must fit too.
@@ -39,7 +40,7 @@ std::optional<SceneFiber> locateSceneFiber(const SceneLayout& layout, uint32_t g
   // empty dataset shares its base with the next one).
   for (size_t i = layout.entries.size(); i-- > 0;) {
     const SceneEntry& e = layout.entries[i];
-    if (e.fiber_base <= global_fiber && global_fiber - e.fiber_base < e.dataset->block().fiber_count)
+    if (e.fiber_base <= global_fiber && global_fiber - e.fiber_base < e.fibers)
       return SceneFiber{uint32_t(i), global_fiber - e.fiber_base};
   }
   return std::nullopt;
@@ -48,11 +49,9 @@ std::optional<SceneFiber> locateSceneFiber(const SceneLayout& layout, uint32_t g
 bool sameScene(const SceneLayout& a, const SceneLayout& b) {
   if (a.entries.size() != b.entries.size() || a.fiblets != b.fiblets || a.fibers != b.fibers) return false;
   for (size_t i = 0; i < a.entries.size(); ++i) {
-    const GpuDataset& x = *a.entries[i].dataset;
-    const GpuDataset& y = *b.entries[i].dataset;
-    if (x.blockAddress() != y.blockAddress() || x.block().fiblet_count != y.block().fiblet_count ||
-        x.block().fiber_count != y.block().fiber_count)
-      return false;
+    const SceneEntry& x = a.entries[i];
+    const SceneEntry& y = b.entries[i];
+    if (x.block != y.block || x.fiblets != y.fiblets || x.fibers != y.fibers) return false;
   }
   return true;
 }
@@ -66,7 +65,7 @@ std::vector<uint32_t> sceneTableWords(const SceneLayout& layout) {
   std::memcpy(words.data(), &header, sizeof(header));
   for (size_t i = 0; i < layout.entries.size(); ++i) {
     shader::SceneDataset entry{};
-    entry.block = layout.entries[i].dataset->blockAddress();
+    entry.block = layout.entries[i].block;
     entry.fiblet_base = layout.entries[i].fiblet_base;
     entry.fiber_base = layout.entries[i].fiber_base;
     std::memcpy(reinterpret_cast<char*>(words.data()) + sizeof(header) + i * sizeof(entry), &entry, sizeof(entry));

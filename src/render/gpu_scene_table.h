@@ -27,6 +27,11 @@ struct SceneEntry {
   const GpuDataset* dataset = nullptr;
   uint32_t fiblet_base = 0;
   uint32_t fiber_base = 0;
+  // Copied from the dataset when the layout was made, so a layout kept
+  // after its datasets are gone (the two-phase history, a pick's frame)
+  // still compares and maps ids without touching them.
+  VkDeviceAddress block = 0;
+  uint32_t fiblets = 0, fibers = 0;
 };
 
 struct SceneLayout {
@@ -42,7 +47,8 @@ struct SceneLayout {
 SceneLayout sceneLayout(std::span<const GpuDataset* const> datasets);
 
 // Which dataset (index into layout.entries) a global fiber belongs to, and
-// its fiber there; nullopt for ids past the scene's fibers.
+// its fiber there; nullopt for ids past the scene's fibers. Reads the
+// entries' copies only.
 struct SceneFiber {
   uint32_t dataset = 0;
   uint32_t fiber = 0;
@@ -51,7 +57,8 @@ std::optional<SceneFiber> locateSceneFiber(const SceneLayout& layout, uint32_t g
 
 // True when both layouts draw the same datasets (block addresses and
 // counts) in the same order: the two-phase history and scene-wide buffers
-// made for one stay valid for the other.
+// made for one stay valid for the other. Reads the entries' copies only
+// (the datasets of either may be gone).
 bool sameScene(const SceneLayout& a, const SceneLayout& b);
 
 // The table as the shaders read it (header + entries), for
