@@ -33,20 +33,6 @@ layout(buffer_reference, std430, buffer_reference_align = 4) buffer AoRef { floa
 
 const float kGoldenAngle = 2.39996323;
 
-// The spiral of kSsaoSamples (16) samples before the per-pixel turn: sample
-// i lies at angle i * golden angle and distance sqrt((i + 0.5) / 16) of the
-// disc's radius; folded to constants by the compiler, so a pixel pays one
-// sine and cosine per scale instead of one per sample.
-#define SSAO_DIR(i) vec2(cos(float(i) * kGoldenAngle), sin(float(i) * kGoldenAngle))
-const vec2 kSampleDir[16] = vec2[16](SSAO_DIR(0), SSAO_DIR(1), SSAO_DIR(2), SSAO_DIR(3), SSAO_DIR(4), SSAO_DIR(5),
-                                     SSAO_DIR(6), SSAO_DIR(7), SSAO_DIR(8), SSAO_DIR(9), SSAO_DIR(10), SSAO_DIR(11),
-                                     SSAO_DIR(12), SSAO_DIR(13), SSAO_DIR(14), SSAO_DIR(15));
-#define SSAO_RADIUS(i) sqrt((float(i) + 0.5) / 16.0)
-const float kSampleRadius[16] =
-    float[16](SSAO_RADIUS(0), SSAO_RADIUS(1), SSAO_RADIUS(2), SSAO_RADIUS(3), SSAO_RADIUS(4), SSAO_RADIUS(5),
-              SSAO_RADIUS(6), SSAO_RADIUS(7), SSAO_RADIUS(8), SSAO_RADIUS(9), SSAO_RADIUS(10), SSAO_RADIUS(11),
-              SSAO_RADIUS(12), SSAO_RADIUS(13), SSAO_RADIUS(14), SSAO_RADIUS(15));
-
 void main() {
   const uvec2 p = gl_GlobalInvocationID.xy;
   if (p.x >= pc.width || p.y >= pc.height) return;
@@ -63,15 +49,12 @@ void main() {
       const float radius = pc.radius_px * float(1u << k);
       const float turn = rotation + float(k) * kGoldenAngle;
       float occluded = 0.0, total = 0.0;
-      const vec2 turn_dir = vec2(cos(turn), sin(turn));
       for (uint i = 0u; i < kSsaoSamples; ++i) {
-        const float r = radius * kSampleRadius[i];
-        // kSampleDir[i] turned by `turn`.
-        const vec2 dir = vec2(kSampleDir[i].x * turn_dir.x - kSampleDir[i].y * turn_dir.y,
-                              kSampleDir[i].x * turn_dir.y + kSampleDir[i].y * turn_dir.x);
-        const float weight = 1.0 - 0.5 * kSampleRadius[i];
+        const float r = radius * sqrt((float(i) + 0.5) / float(kSsaoSamples));
+        const float a = float(i) * kGoldenAngle + turn;
+        const float weight = 1.0 - 0.5 * r / radius;
         total += weight;
-        const ivec2 q = ivec2(floor(vec2(p) + 0.5 + r * dir));
+        const ivec2 q = ivec2(floor(vec2(p) + 0.5 + r * vec2(cos(a), sin(a))));
         if (q.x < 0 || q.y < 0 || q.x >= int(pc.width) || q.y >= int(pc.height)) continue;
         const GBufferTexel t = gbuffer.texels[uint(q.y) * pc.width + uint(q.x)];
         if (t.fiber == kNoFiberId || t.fiber == centre.fiber) continue;

@@ -38,8 +38,8 @@ SHADE_CONST uint kShadeLightingIlluminated = 1u;
 
 // Neighbours sampled per pixel by ssao.comp (a Vogel spiral, rotated per
 // pixel), and the blur's half width in pixels.
-SHADE_CONST uint kSsaoSamples = 16u;  // ssao.comp has a spiral table of this many samples
-SHADE_CONST uint kSsaoBlurRadius = 4u;  // ssao_blur.comp has a weight table of this many taps
+SHADE_CONST uint kSsaoSamples = 16u;
+SHADE_CONST uint kSsaoBlurRadius = 4u;
 // RenderSettings::ao_scales at most: radii r, 2r, 4r, 8r.
 SHADE_CONST uint kSsaoMaxScales = 4u;
 
