@@ -64,6 +64,22 @@ void rasterClipSegment(VisibilityRef vis, CameraBlock cam, vec4 c0, vec4 c1, uin
   const vec3 ab = b - a;
   const float length2 = dot(ab.xy, ab.xy);
   const float radius2 = radius * radius;
+  // A short segment (the common case at whole-brain zoom: steps of a pixel
+  // or less) has all its candidate centres (those within `radius` of its
+  // box) in one 2 x 2 block: tested straight, without the walk's nested
+  // loops, whose trip counts differ from lane to lane (on a CPU device the
+  // SIMD lanes run the longest lane's loop: 2.4x the pixel tests needed).
+  // The block's other pixels fail the per-pixel test, so the result is the
+  // walk's.
+  if (max(abs(ab.x), abs(ab.y)) + 2.0 * radius < 2.0) {
+    const int x0 = int(ceil(min(a.x, b.x) - radius - 0.5)), y0 = int(ceil(min(a.y, b.y) - radius - 0.5));
+    for (int j = 0; j < 4; ++j) {
+      const int px = x0 + (j & 1), py = y0 + (j >> 1);
+      if (px >= 0 && py >= 0 && px < int(width) && py < int(height))
+        rasterPixel(vis, width, px, py, a, ab, length2, radius2, payload);
+    }
+    return;
+  }
   // Walk the major axis; `major` / `minor` index x or y.
   const bool x_major = abs(ab.x) >= abs(ab.y);
   const int major = x_major ? 0 : 1, minor = 1 - major;
