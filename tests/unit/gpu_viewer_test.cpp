@@ -408,6 +408,24 @@ TEST_F(GpuViewer, windowedRunUnderXvfbPresentsThroughASwapchain) {
   expectSceneAndPanels(readOurPng(png));
 }
 
+// --no-vsync asks the surface for mailbox or immediate presentation (Xvfb's
+// lavapipe surface offers both); the default waits for vertical sync (FIFO).
+TEST_F(GpuViewer, noVsyncPresentsWithoutWaitingForVerticalSync) {
+  if (test::runCommand("command -v xvfb-run").exit_code != 0) GTEST_SKIP() << "xvfb-run is not installed";
+  const std::string prefix = "xvfb-run -a -s '-screen 0 640x480x24' env ";
+  const auto fifo = runViewer("--size 320x200 --frames 2", prefix);
+  ASSERT_EQ(fifo.exit_code, 0) << fifo.output;
+  EXPECT_NE(fifo.output.find("present mode fifo"), std::string::npos) << fifo.output;
+  const std::string png = dir_.file("nv.png");
+  const auto r = runViewer("--no-vsync --size 320x200 --frames 3 --screenshot " + png, prefix);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output.find("present mode fifo"), std::string::npos) << r.output;
+  EXPECT_TRUE(r.output.find("present mode mailbox") != std::string::npos ||
+              r.output.find("present mode immediate") != std::string::npos)
+      << r.output;
+  expectSceneAndPanels(readOurPng(png));
+}
+
 TEST_F(GpuViewer, scriptedSessionRunsCleanUnderValidation) {
   const std::string script = dir_.file("session.txt");
   const std::string scene_png = dir_.file("scene.png"), shown_png = dir_.file("shown.png");

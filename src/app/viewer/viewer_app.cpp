@@ -264,6 +264,8 @@ void ViewerApp::createFrameObjects() {
     window_->framebufferSize(width, height);
     if (width == 0 || height == 0) width = options_.width, height = options_.height;
     swapchain_ = gpu::createSwapchain(*context_, width, height, gpu::SwapchainOptions{options_.vsync});
+    std::fprintf(stderr, "fibscope view: window %ux%u, present mode %s\n", swapchain_.extent.width,
+                 swapchain_.extent.height, gpu::presentModeName(swapchain_.present_mode));
   }
   presentation_ = createPresentation(*context_, width, height);
   imgui_ = std::make_unique<ImGuiLayer>(*context_, presentation_.render_pass, window_ ? window_->handle() : nullptr);
