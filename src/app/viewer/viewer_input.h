@@ -20,7 +20,7 @@ struct InputEvent {
   enum class Type : uint8_t { CursorMoved, MouseButton, Scroll, Key, Drop };
   enum Button : int { kLeft = 0, kRight = 1, kMiddle = 2 };
   Type type = Type::CursorMoved;
-  double x = 0, y = 0;  // CursorMoved: window pixels; Scroll: wheel offsets
+  double x = 0, y = 0;  // CursorMoved, MouseButton: framebuffer pixels (screenToFramebuffer); Scroll: wheel offsets
   int button = 0;       // MouseButton
   int key = 0;          // Key: a GLFW_KEY_* code
   bool pressed = false;  // MouseButton, Key (repeat counts as pressed)

@@ -89,6 +89,26 @@ std::vector<InputEvent> ViewerWindow::takeEvents() {
   return events;
 }
 
+void screenToFramebuffer(double& x, double& y, int window_width, int window_height, int framebuffer_width,
+                         int framebuffer_height) {
+  if (window_width <= 0 || window_height <= 0 || framebuffer_width <= 0 || framebuffer_height <= 0) return;
+  x *= double(framebuffer_width) / double(window_width);
+  y *= double(framebuffer_height) / double(window_height);
+}
+
+namespace {
+
+// Events carry framebuffer pixels: picks and pans (the point under the
+// cursor follows it) are then exact on any display scale.
+void toFramebuffer(GLFWwindow* window, double& x, double& y) {
+  int ww = 0, wh = 0, fw = 0, fh = 0;
+  glfwGetWindowSize(window, &ww, &wh);
+  glfwGetFramebufferSize(window, &fw, &fh);
+  screenToFramebuffer(x, y, ww, wh, fw, fh);
+}
+
+}  // namespace
+
 ViewerWindow& ViewerWindow::from(GLFWwindow* window) {
   return *static_cast<ViewerWindow*>(glfwGetWindowUserPointer(window));
 }
@@ -98,6 +118,7 @@ void ViewerWindow::onCursor(GLFWwindow* window, double x, double y) {
   e.type = InputEvent::Type::CursorMoved;
   e.x = x;
   e.y = y;
+  toFramebuffer(window, e.x, e.y);
   from(window).events_.push_back(std::move(e));
 }
 
@@ -113,6 +134,7 @@ void ViewerWindow::onButton(GLFWwindow* window, int button, int action, int mods
   e.control = mods & GLFW_MOD_CONTROL;
   // The press position: the drag starts where the button went down.
   glfwGetCursorPos(window, &e.x, &e.y);
+  toFramebuffer(window, e.x, e.y);
   from(window).events_.push_back(std::move(e));
 }
 

@@ -17,6 +17,13 @@ struct GLFWwindow;
 
 namespace fibscope {
 
+// A cursor position in screen coordinates (GLFW's, what the mouse moves
+// in) as framebuffer pixels (what the renderer draws and picks in): they
+// differ on high-DPI displays, where a screen coordinate spans several
+// pixels. Unscaled while either size is zero (a minimised window).
+void screenToFramebuffer(double& x, double& y, int window_width, int window_height, int framebuffer_width,
+                         int framebuffer_height);
+
 class ViewerWindow {
  public:
   // A window of width x height screen coordinates, or null with `why_not`
