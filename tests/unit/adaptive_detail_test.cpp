@@ -54,5 +54,16 @@ TEST(AdaptiveDetail, sameViewComparesThePoseAndFieldOfViewNotTheSize) {
   EXPECT_FALSE(sameView(a, b));
 }
 
+TEST(AdaptiveDetail, slowHalfResolutionMovesDropToAQuarterAndComeBackWithoutAlternating) {
+  EXPECT_EQ(coarseDivisor(2, 0), 2u) << "the first coarse frame: half resolution";
+  EXPECT_EQ(coarseDivisor(2, kSlowFrameMs / 2), 2u);
+  EXPECT_EQ(coarseDivisor(2, kSlowFrameMs + 1), 4u) << "still slow at half resolution";
+  EXPECT_EQ(coarseDivisor(4, kSlowFrameMs + 1), 4u);
+  EXPECT_EQ(coarseDivisor(4, kSlowFrameMs / 2), 4u)
+      << "a quarter-resolution frame of half the limit would be about twice the limit at half resolution";
+  EXPECT_EQ(coarseDivisor(4, kSlowFrameMs / 5), 2u) << "fast enough to go back";
+  EXPECT_EQ(coarseDivisor(4, 0), 4u) << "no time measured: keep";
+}
+
 }  // namespace
 }  // namespace fibscope

@@ -19,4 +19,9 @@ RenderSettings coarseSettings(RenderSettings settings, float moving_lod_px) {
   return settings;
 }
 
+unsigned coarseDivisor(unsigned last_divisor, double last_coarse_frame_ms) {
+  if (last_divisor == 4) return last_coarse_frame_ms > 0 && last_coarse_frame_ms < kSlowFrameMs / 4 ? 2 : 4;
+  return last_coarse_frame_ms > kSlowFrameMs ? 4 : 2;
+}
+
 }  // namespace fibscope

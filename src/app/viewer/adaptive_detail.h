@@ -30,4 +30,13 @@ bool drawCoarse(bool adaptive, const RenderSettings& settings, bool moving, doub
 // full-screen passes and a blur, a large share of a coarse frame on a CPU).
 RenderSettings coarseSettings(RenderSettings settings, float moving_lod_px);
 
+// How much smaller than the window a coarse frame is drawn (2 or 4 per
+// side), from the last coarse frame's divisor and time (submission to
+// completion, ms; 0 before any): 2 to start; 4 once a half-resolution frame
+// is still slower than kSlowFrameMs (a coarse frame's raster is bound by its
+// pixels, so a quarter of them is about four times faster); back to 2 when
+// a quarter-resolution frame takes under a quarter of kSlowFrameMs, so the
+// two never alternate.
+unsigned coarseDivisor(unsigned last_divisor, double last_coarse_frame_ms);
+
 }  // namespace fibscope

@@ -211,6 +211,8 @@ class ViewerApp {
   bool submitted_coarse_ = false;  // the frame in flight
   Clock::time_point submitted_at_;
   double last_full_frame_ms_ = 0;
+  double last_coarse_frame_ms_ = 0;  // submission to completion of the last coarse frame
+  unsigned coarse_divisor_ = 2;      // a coarse frame's size: the window's / this (coarseDivisor)
   Camera last_camera_;  // of the last frame recorded
   Clock::time_point frame_start_;
   double last_frame_ms_ = 0;
@@ -781,8 +783,9 @@ void ViewerApp::finishFrame() {
   in_flight_ = false;
   // Submission to completion (an upper bound of the GPU's time: lavapipe's
   // timestamps are not trusted) of the last full-detail frame.
-  if (!submitted_coarse_)
-    last_full_frame_ms_ = std::chrono::duration<double, std::milli>(Clock::now() - submitted_at_).count();
+  const double submitted_ms = std::chrono::duration<double, std::milli>(Clock::now() - submitted_at_).count();
+  if (submitted_coarse_) last_coarse_frame_ms_ = submitted_ms;
+  else last_full_frame_ms_ = submitted_ms;
   state_.coarse_frame = submitted_coarse_;
   FrameRecord record;
   record.frame_ms = last_frame_ms_;
@@ -821,9 +824,12 @@ void ViewerApp::recordFrame(VkCommandBuffer cmd, uint32_t width, uint32_t height
       frame_coarse_ = true;
     }
     if (frame_coarse_) {
-      // At half resolution (the coarse frame is bound by its pixels: long
-      // LoD segments), stretched over the window's colour buffer.
-      const uint32_t half_width = std::max(1u, width / 2), half_height = std::max(1u, height / 2);
+      // At half (or, where that is still slow, quarter) resolution: the
+      // coarse frame is bound by its pixels (long LoD segments); stretched
+      // over the window's colour buffer.
+      coarse_divisor_ = coarseDivisor(coarse_divisor_, last_coarse_frame_ms_);
+      const uint32_t half_width = std::max(1u, width / coarse_divisor_),
+                     half_height = std::max(1u, height / coarse_divisor_);
       if (!coarse_renderer_) coarse_renderer_ = std::make_unique<FrameRenderer>(*context_, half_width, half_height);
       else if (coarse_renderer_->targets().width != half_width || coarse_renderer_->targets().height != half_height)
         coarse_renderer_->resize(half_width, half_height);
