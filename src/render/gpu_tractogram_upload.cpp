@@ -145,27 +145,41 @@ StreamedUpload uploadStreamed(const ContextSource& context,
   std::vector<std::unique_ptr<FibletEncoder>> encoders;
   ThreadPool pool;
   for (unsigned i = 0; i < pool.size(); ++i) encoders.push_back(std::make_unique<FibletEncoder>(out.upload.params));
-  std::deque<std::future<void>> in_flight;
+  // Jobs with their chunks: a finished job's chunk is read into again
+  // (its buffers keep their capacity, so reading does not fault in fresh
+  // pages for every chunk).
+  std::deque<std::pair<std::future<void>, std::shared_ptr<Tractogram>>> in_flight;
+  std::vector<std::shared_ptr<Tractogram>> spare;
+  auto retireOldest = [&] {
+    in_flight.front().first.get();
+    // Reused only once the job has let go of it (the pool may still hold
+    // the finished task for a moment).
+    if (in_flight.front().second.use_count() == 1) spare.push_back(std::move(in_flight.front().second));
+    in_flight.pop_front();
+  };
   {
     auto reader = open();
     for (;;) {
-      auto chunk = std::make_shared<Tractogram>();
+      if (in_flight.size() >= 2 * size_t(pool.size())) retireOldest();
+      std::shared_ptr<Tractogram> chunk;
+      if (spare.empty()) {
+        chunk = std::make_shared<Tractogram>();
+      } else {
+        chunk = std::move(spare.back());
+        spare.pop_back();
+      }
       if (!reader->read(*chunk, kEncodeChunkPoints)) break;
       EncodedFiblets* part = &parts.emplace_back();
       std::vector<float>* part_lengths = &lengths.emplace_back();
-      if (in_flight.size() >= 2 * size_t(pool.size())) {
-        in_flight.front().get();
-        in_flight.pop_front();
-      }
-      in_flight.push_back(pool.submit([chunk, part, part_lengths, &encoders](unsigned worker) {
+      in_flight.emplace_back(pool.submit([chunk, part, part_lengths, &encoders](unsigned worker) {
         encoders[worker]->encode(*chunk, *part);
         part_lengths->resize(chunk->streamlineCount());
         for (size_t s = 0; s < part_lengths->size(); ++s)
           (*part_lengths)[s] = polylineLength(chunk->point(chunk->offsets[s]), chunk->pointsIn(s));
-      }));
+      }), chunk);
     }
   }
-  for (auto& d : in_flight) d.get();
+  for (auto& job : in_flight) job.first.get();
   const EncodedFiblets encoded = joinParts(parts, out.upload.params.recordBytes());
   std::vector<float> all_lengths;
   all_lengths.reserve(out.streamlines);
