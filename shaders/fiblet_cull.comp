@@ -5,13 +5,24 @@
 // lod_pixels go to the LoD list (drawn as one segment), the others to the
 // full list. Modes and the argument for conservativeness: shared/cull_push.h.
 //
-// Bounding sphere: centre = the first point p0. The decoder places point 1
-// as stored and every later point delta from the previous one (a rotation of
-// a unit direction), so point k lies within |p1 - p0| + (k - 1) * delta of
-// p0; the joining segment ends at the next fiblet's first point, read
-// exactly. The radius is the larger of the two bounds (not N * delta: the
-// stored p1 need not be delta from p0, and a short fiblet gets a small
-// sphere), with kCullRadiusSlack for rounding.
+// Bounding sphere: the dataset's precomputed one when it has them
+// (FibletDataset::fiblet_bounds, fiblet_bounds.comp): centred on the
+// middle of the fiblet's box, its radius the largest distance to a point
+// the fiblet draws (its decoded points and the joining point), found by
+// decoding exactly as the serial raster does and enlarged by
+// fibletBoundsRadius's slack for the rounding by which the other decode
+// orders differ (shared/cull_push.h). Every segment the rasters draw joins
+// two of those points, and a sphere is convex, so it holds every segment;
+// the tests below only ever ask whether something lies outside the sphere.
+//
+// Fallback without them, from the record alone: centre = the first point
+// p0. The decoder places point 1 as stored and every later point delta from
+// the previous one (a rotation of a unit direction), so point k lies within
+// |p1 - p0| + (k - 1) * delta of p0; the joining segment ends at the next
+// fiblet's first point, read exactly. The radius is the larger of the two
+// bounds (not N * delta: the stored p1 need not be delta from p0, and a
+// short fiblet gets a small sphere), with kCullRadiusSlack for rounding.
+// About twice the precomputed radius for a straight fiblet.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_buffer_reference : require
@@ -40,9 +51,17 @@ vec4 matrixRow(CameraBlock cam, int i) {
               cam.view_projection[3][i]);
 }
 
+layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer BoundsRef { vec4 spheres[]; };
+
 // False for a fiblet that draws nothing (a single point ending its fiber,
 // or a record the raster would refuse).
 bool fibletSphere(FibletDataset ds, uint fiblet, out vec3 centre, out float radius) {
+  if (ds.fiblet_bounds != 0ul) {
+    const vec4 sphere = BoundsRef(ds.fiblet_bounds).spheres[fiblet];
+    centre = sphere.xyz;
+    radius = sphere.w;
+    return sphere.w >= 0.0;
+  }
   WordsRef records = WordsRef(ds.records);
   const uint n = ds.points_per_fiblet;
   const uint base = fiblet * ds.record_words;
@@ -81,7 +100,12 @@ bool sphereInFrustum(CameraBlock cam, vec3 c, float r) {
 }
 
 // Far-view LoD: the sphere's projected diameter, measured at its nearest
-// view distance, below lod_pixels.
+// view distance, below lod_pixels. With the precomputed sphere the diameter
+// is about the fiblet's own extent, so a fiblet becomes one segment when it
+// spans fewer than lod_pixels on screen, as the setting says (the fallback
+// sphere's diameter is about twice the extent: it switched at half of
+// that). The LoD segment runs from p0 to the joining point (or p1), inside
+// the sphere, so it stays within the frustum and occlusion bounds too.
 bool sphereIsSmall(CameraBlock cam, vec3 c, float r) {
   if (!(pc.lod_pixels > 0.0)) return false;
   const vec4 r3 = matrixRow(cam, 3);  // w_clip = view distance along the axis

@@ -48,6 +48,22 @@ CULL_CONST float kCullRadiusSlack = 1.0e-3f;
 CULL_CONST float kCullPixelSlack = 1.0f;
 CULL_CONST float kCullDepthSlack = 1.0e-5f;
 
+// Absolute slack of the precomputed fiblet spheres (fiblet_bounds.comp), as
+// a fraction of the dataset's reach: mm_per_unit (the normalised cube's
+// side) plus the largest |translation| component. The bounds pass decodes
+// serially; the parallel-prefix rasters compose the same transforms in
+// another order, so their points differ from the bounds pass's by float
+// rounding. Each composition rounds the translation (|t| <= sqrt(3) in
+// normalised units) by a few ulps, about 8e-7; over at most 59
+// compositions that is 5e-5 even if every rounding went the same way
+// (FibletDecoder tests scan against sequential within 1e-6 of the scene
+// size on real data; the rotations' rounding moves points by a relative
+// amount of the distance travelled, which kCullRadiusSlack covers). The
+// world transform rounds each coordinate by an ulp of its magnitude, 1e-7
+// of the reach. 1e-4 is twice the worst case of both, and still only
+// 0.02 mm of a 200 mm brain: nothing next to a line's width.
+CULL_CONST float kCullBoundsSlack = 1.0e-4f;
+
 // fiblet_cull.comp: one invocation per fiblet (kCullGroupSize per group).
 struct FibletCullPush {
   uint64_t dataset;   // FibletDataset block
@@ -65,6 +81,22 @@ struct FibletCullPush {
   float focal_px;     // projection scale in px: |P[1][1]| * height / 2
   uint pad;
 };
+
+// fiblet_bounds.comp: one invocation per fiblet (kCullGroupSize per group)
+// writes FibletDataset::fiblet_bounds.
+struct FibletBoundsPush {
+  uint64_t dataset;  // FibletDataset block (its fiblet_bounds may still be 0)
+  uint64_t bounds;   // vec4 per fiblet: world centre, radius (< 0: draws nothing)
+};
+
+// A precomputed sphere's radius from the exact largest distance (world mm)
+// of the serially decoded points to the centre: enlarged for the rounding
+// by which the rasters' decode orders and their world transform differ
+// (kCullRadiusSlack relative, kCullBoundsSlack of `reach_mm` = mm_per_unit
+// + the largest |translation| component).
+SHADER_FN float fibletBoundsRadius(float farthest_mm, float reach_mm) {
+  return farthest_mm * (1.0f + kCullRadiusSlack) + kCullBoundsSlack * reach_mm;
+}
 
 // fiblet_list_finalize.comp: one invocation turns a list's count into its
 // indirect dispatch size.
@@ -131,6 +163,7 @@ SHADER_NAMESPACE_END
 
 #ifdef __cplusplus
 static_assert(sizeof(fibscope::shader::FibletCullPush) == 64, "");
+static_assert(sizeof(fibscope::shader::FibletBoundsPush) == 16, "");
 static_assert(sizeof(fibscope::shader::FibletListFinalizePush) == 16, "");
 static_assert(sizeof(fibscope::shader::DepthPyramidPush) == 32, "");
 static_assert(sizeof(fibscope::shader::FibletLodRasterPush) == 48, "");

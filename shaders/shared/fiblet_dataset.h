@@ -3,7 +3,7 @@
 //
 // It lives in a small device-local buffer of its own, and a pass receives
 // only that buffer's device address in its push constants (8 bytes). As a
-// push constant the block would take 88 of the 128 bytes Vulkan guarantees,
+// push constant the block would take 96 of the 128 bytes Vulkan guarantees,
 // leaving too little for a pass's own outputs and camera; read through a
 // buffer reference it costs one uniform, cached load per workgroup.
 //
@@ -23,7 +23,7 @@
 SHADER_NAMESPACE_BEGIN
 
 // std430 and C++ agree: the uint64_t members first, then 4-byte scalars
-// only (no vec3/vec4, whose GLSL alignment differs), 88 bytes in all.
+// only (no vec3/vec4, whose GLSL alignment differs), 96 bytes in all.
 struct FibletDataset {
   // uint words, record_words per fiblet: the .fbl "fiblets" section as is.
   uint64_t records;
@@ -42,6 +42,11 @@ struct FibletDataset {
   uint64_t fiber_first_fiblet;
   // float per fiber: its length in mm (the length filter).
   uint64_t fiber_length_mm;
+  // vec4 per fiblet, or 0 (none): each fiblet's bounding sphere in world mm
+  // (xyz centre, w radius; w < 0: the fiblet draws nothing), computed on the
+  // device after the upload by fiblet_bounds.comp (render/gpu_fiblet_bounds.h).
+  // The cull uses it when present, else a looser bound from the record.
+  uint64_t fiblet_bounds;
   uint fiber_count;
   uint fiblet_count;
   uint record_words;       // uint words per fiblet record: fibletRecordBytes(N) / 4
@@ -61,9 +66,10 @@ struct FibletDataset {
 SHADER_NAMESPACE_END
 
 #ifdef __cplusplus
-static_assert(sizeof(fibscope::shader::FibletDataset) == 88, "the dataset block is 88 bytes in std430");
-static_assert(offsetof(fibscope::shader::FibletDataset, fiber_count) == 40, "scalars follow the five addresses");
-static_assert(offsetof(fibscope::shader::FibletDataset, translation_x) == 56, "floats follow the four uints");
+static_assert(sizeof(fibscope::shader::FibletDataset) == 96, "the dataset block is 96 bytes in std430");
+static_assert(offsetof(fibscope::shader::FibletDataset, fiblet_bounds) == 40, "the bounds follow the tables");
+static_assert(offsetof(fibscope::shader::FibletDataset, fiber_count) == 48, "scalars follow the six addresses");
+static_assert(offsetof(fibscope::shader::FibletDataset, translation_x) == 64, "floats follow the four uints");
 #endif
 
 #endif  // FIBSCOPE_SHADERS_SHARED_FIBLET_DATASET_H

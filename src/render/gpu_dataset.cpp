@@ -10,6 +10,7 @@
 #include "core/error.h"
 #include "gpu/submit.h"
 #include "gpu/vk_check.h"
+#include "render/gpu_fiblet_bounds.h"
 #include "render/gpu_staged_upload.h"
 
 namespace fibscope {
@@ -89,7 +90,7 @@ DeviceLimits deviceLimits(const gpu::VulkanContext& context) {
 }
 
 uint64_t DatasetBytes::largest() const {
-  return std::max({records, fiblet_fiber, directions, fiber_first_fiblet, fiber_length, block});
+  return std::max({records, fiblet_fiber, directions, fiber_first_fiblet, fiber_length, block, bounds});
 }
 
 DatasetBytes datasetBytes(uint64_t fibers, uint64_t fiblets, uint32_t record_bytes) {
@@ -100,6 +101,7 @@ DatasetBytes datasetBytes(uint64_t fibers, uint64_t fiblets, uint32_t record_byt
   bytes.fiber_first_fiblet = (fibers + 1) * sizeof(uint32_t);
   bytes.fiber_length = fibers * sizeof(float);
   bytes.block = sizeof(shader::FibletDataset);
+  bytes.bounds = fiblets * kFibletBoundsBytes;
   return bytes;
 }
 
@@ -138,6 +140,7 @@ GpuDataset::GpuDataset(GpuDataset&& other) noexcept
       fiber_first_fiblet_(std::exchange(other.fiber_first_fiblet_, {})),
       fiber_length_(std::exchange(other.fiber_length_, {})),
       block_buffer_(std::exchange(other.block_buffer_, {})),
+      bounds_(std::exchange(other.bounds_, {})),
       block_(std::exchange(other.block_, {})) {}
 
 GpuDataset& GpuDataset::operator=(GpuDataset&& other) noexcept {
@@ -150,6 +153,7 @@ GpuDataset& GpuDataset::operator=(GpuDataset&& other) noexcept {
     fiber_first_fiblet_ = std::exchange(other.fiber_first_fiblet_, {});
     fiber_length_ = std::exchange(other.fiber_length_, {});
     block_buffer_ = std::exchange(other.block_buffer_, {});
+    bounds_ = std::exchange(other.bounds_, {});
     block_ = std::exchange(other.block_, {});
   }
   return *this;
@@ -157,7 +161,8 @@ GpuDataset& GpuDataset::operator=(GpuDataset&& other) noexcept {
 
 void GpuDataset::release() {
   if (!context_) return;
-  for (gpu::Buffer* b : {&records_, &fiblet_fiber_, &directions_, &fiber_first_fiblet_, &fiber_length_, &block_buffer_})
+  for (gpu::Buffer* b :
+       {&records_, &fiblet_fiber_, &directions_, &fiber_first_fiblet_, &fiber_length_, &block_buffer_, &bounds_})
     gpu::destroyBuffer(*context_, *b);
   context_ = nullptr;
   block_ = {};
@@ -165,7 +170,13 @@ void GpuDataset::release() {
 
 uint64_t GpuDataset::bytes() const {
   return records_.size + fiblet_fiber_.size + directions_.size + fiber_first_fiblet_.size + fiber_length_.size +
-         block_buffer_.size;
+         block_buffer_.size + bounds_.size;
+}
+
+void GpuDataset::useFibletBounds(bool use) {
+  if (!context_) return;
+  block_.fiblet_bounds = use ? bounds_.address : 0;
+  gpu::uploadToBuffer(*context_, block_buffer_, &block_, sizeof block_);
 }
 
 // What both upload paths hand to the common part, after the size check.
@@ -187,6 +198,7 @@ void GpuDataset::fill(const gpu::VulkanContext& context, const Source& source, c
   fiber_first_fiblet_ = gpu::createBuffer(context, bufferSize(bytes.fiber_first_fiblet), gpu::MemoryUse::DeviceLocal);
   fiber_length_ = gpu::createBuffer(context, bufferSize(bytes.fiber_length), gpu::MemoryUse::DeviceLocal);
   block_buffer_ = gpu::createBuffer(context, bufferSize(bytes.block), gpu::MemoryUse::DeviceLocal);
+  bounds_ = gpu::createBuffer(context, bufferSize(bytes.bounds), gpu::MemoryUse::DeviceLocal);
 
   const CodecParams& params = source.params;
   block_.records = records_.address;
@@ -194,6 +206,7 @@ void GpuDataset::fill(const gpu::VulkanContext& context, const Source& source, c
   block_.directions = directions_.address;
   block_.fiber_first_fiblet = fiber_first_fiblet_.address;
   block_.fiber_length_mm = fiber_length_.address;
+  block_.fiblet_bounds = bounds_.address;
   block_.fiber_count = uint32_t(source.tables.first.size() - 1);
   block_.fiblet_count = uint32_t(source.tables.fiblet_fiber.size());
   block_.record_words = params.recordBytes() / 4;
@@ -238,6 +251,8 @@ void GpuDataset::fill(const gpu::VulkanContext& context, const Source& source, c
     throw;
   }
   gpu::destroyBuffer(context, staging);
+  computeFibletBounds(context, block_buffer_.address, bounds_.address, block_.fiblet_count);
+  if (progress) progress->add(double(bytes.bounds));
 }
 
 GpuDataset GpuDataset::upload(const gpu::VulkanContext& context, const FblFile& file, Progress* progress,

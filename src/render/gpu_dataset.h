@@ -9,7 +9,9 @@
 // the device is not implemented yet.
 //
 // Sections are copied through one bounded staging buffer, so a 10 GB
-// section needs no 10 GB of host-visible memory.
+// section needs no 10 GB of host-visible memory. After the copies a compute
+// pass decodes every fiblet once into its bounding sphere (16 bytes per
+// fiblet, render/gpu_fiblet_bounds.h), which the cull reads.
 #pragma once
 
 #include <cstdint>
@@ -52,8 +54,11 @@ struct DatasetBytes {
   uint64_t fiber_first_fiblet = 0;
   uint64_t fiber_length = 0;
   uint64_t block = 0;
+  uint64_t bounds = 0;  // computed on the device, not uploaded
 
-  uint64_t total() const { return records + fiblet_fiber + directions + fiber_first_fiblet + fiber_length + block; }
+  uint64_t total() const {
+    return records + fiblet_fiber + directions + fiber_first_fiblet + fiber_length + block + bounds;
+  }
   uint64_t largest() const;
 };
 DatasetBytes datasetBytes(uint64_t fibers, uint64_t fiblets, uint32_t record_bytes);
@@ -80,7 +85,8 @@ class GpuDataset {
   // the device's own, for tests), when a section is missing, of the wrong
   // type or size, or fails its checksum, or when fiber_first_fiblet is not
   // increasing from 0 to the fiblet count. `progress` (optional) counts the
-  // bytes uploaded; sections are copied `staging_bytes` at a time.
+  // bytes uploaded (and the fiblet bounds' bytes once computed); sections
+  // are copied `staging_bytes` at a time.
   static GpuDataset upload(const gpu::VulkanContext& context, const FblFile& file, Progress* progress = nullptr,
                            const DeviceLimits* limits = nullptr, uint64_t staging_bytes = kDatasetStagingBytes);
 
@@ -106,6 +112,13 @@ class GpuDataset {
   const gpu::Buffer& fiberFirstFiblet() const { return fiber_first_fiblet_; }
   const gpu::Buffer& fiberLength() const { return fiber_length_; }
   const gpu::Buffer& blockBuffer() const { return block_buffer_; }
+  // vec4 per fiblet: world centre and radius (< 0: draws nothing).
+  const gpu::Buffer& fibletBounds() const { return bounds_; }
+
+  // Whether the block names the bounds buffer (true after upload). False
+  // makes the cull fall back to the looser bound from the record, for
+  // comparisons; rewrites the block buffer, so the GPU must not be using it.
+  void useFibletBounds(bool use);
 
  private:
   struct Source;
@@ -114,7 +127,7 @@ class GpuDataset {
   void release();
 
   const gpu::VulkanContext* context_ = nullptr;
-  gpu::Buffer records_, fiblet_fiber_, directions_, fiber_first_fiblet_, fiber_length_, block_buffer_;
+  gpu::Buffer records_, fiblet_fiber_, directions_, fiber_first_fiblet_, fiber_length_, block_buffer_, bounds_;
   shader::FibletDataset block_{};
 };
 

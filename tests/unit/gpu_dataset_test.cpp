@@ -96,6 +96,7 @@ class GpuDatasetUpload : public test::GpuTest {
     EXPECT_EQ(block.directions, dataset.directions().address);
     EXPECT_EQ(block.fiber_first_fiblet, dataset.fiberFirstFiblet().address);
     EXPECT_EQ(block.fiber_length_mm, dataset.fiberLength().address);
+    EXPECT_EQ(block.fiblet_bounds, dataset.fibletBounds().address);
 
     EXPECT_TRUE(sameBytes(download<uint8_t>(context(), dataset.records(), records.size()), records))
         << "records differ from the fiblets section";
@@ -128,7 +129,7 @@ class GpuDatasetUpload : public test::GpuTest {
     EXPECT_EQ(first[fibers], fiblets);
 
     EXPECT_EQ(dataset.bytes(), records.size() + 4 * fiblets + 4 * sizeof table + 4 * (fibers + 1) + 4 * fibers +
-                                   sizeof(shader::FibletDataset));
+                                   sizeof(shader::FibletDataset) + 16 * fiblets);  // + the fiblet bounds
   }
 
   // Decodes every fiblet through the block; compares with decodeScan.
