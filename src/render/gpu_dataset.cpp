@@ -141,7 +141,8 @@ GpuDataset::GpuDataset(GpuDataset&& other) noexcept
       fiber_length_(std::exchange(other.fiber_length_, {})),
       block_buffer_(std::exchange(other.block_buffer_, {})),
       bounds_(std::exchange(other.bounds_, {})),
-      block_(std::exchange(other.block_, {})) {}
+      block_(std::exchange(other.block_, {})),
+      bounds_ready_(std::exchange(other.bounds_ready_, false)) {}
 
 GpuDataset& GpuDataset::operator=(GpuDataset&& other) noexcept {
   if (this != &other) {
@@ -155,6 +156,7 @@ GpuDataset& GpuDataset::operator=(GpuDataset&& other) noexcept {
     block_buffer_ = std::exchange(other.block_buffer_, {});
     bounds_ = std::exchange(other.bounds_, {});
     block_ = std::exchange(other.block_, {});
+    bounds_ready_ = std::exchange(other.bounds_ready_, false);
   }
   return *this;
 }
@@ -173,9 +175,37 @@ uint64_t GpuDataset::bytes() const {
          block_buffer_.size + bounds_.size;
 }
 
+void GpuDataset::computeFibletBounds() {
+  if (!context_) return;
+  fibscope::computeFibletBounds(*context_, block_buffer_.address, bounds_.address, block_.fiblet_count);
+  bounds_ready_ = true;
+  useFibletBounds(true);
+}
+
+void GpuDataset::recordFibletBoundsOnce(VkCommandBuffer cmd, const FibletBoundsPass& pass) const {
+  if (!context_ || bounds_ready_) return;
+  // Earlier work of this command buffer (uploads are separate submissions,
+  // already complete) needs no barrier: the pass reads records, table and
+  // block, which only transfers of finished submissions wrote.
+  recordFibletBounds(cmd, *context_, pass, block_buffer_.address, bounds_.address, block_.fiblet_count);
+  // The pass (and earlier frames' passes) read the block: done before the
+  // update writes it.
+  gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_READ_BIT,
+                     VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+  block_.fiblet_bounds = bounds_.address;
+  vkCmdUpdateBuffer(cmd, block_buffer_.buffer, offsetof(shader::FibletDataset, fiblet_bounds),
+                    sizeof block_.fiblet_bounds, &block_.fiblet_bounds);
+  // The spheres (compute) and the block's new address (transfer) before
+  // the cull reads them.
+  gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_TRANSFER_BIT,
+                     VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                     VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
+  bounds_ready_ = true;
+}
+
 void GpuDataset::useFibletBounds(bool use) {
   if (!context_) return;
-  block_.fiblet_bounds = use ? bounds_.address : 0;
+  block_.fiblet_bounds = use && bounds_ready_ ? bounds_.address : 0;
   gpu::uploadToBuffer(*context_, block_buffer_, &block_, sizeof block_);
 }
 
@@ -206,7 +236,7 @@ void GpuDataset::fill(const gpu::VulkanContext& context, const Source& source, c
   block_.directions = directions_.address;
   block_.fiber_first_fiblet = fiber_first_fiblet_.address;
   block_.fiber_length_mm = fiber_length_.address;
-  block_.fiblet_bounds = bounds_.address;
+  block_.fiblet_bounds = 0;  // filled when the occlusion cull first needs them
   block_.fiber_count = uint32_t(source.tables.first.size() - 1);
   block_.fiblet_count = uint32_t(source.tables.fiblet_fiber.size());
   block_.record_words = params.recordBytes() / 4;
@@ -234,7 +264,7 @@ void GpuDataset::fill(const gpu::VulkanContext& context, const Source& source, c
     table.push_back({l.c2.z, l.t.x, l.t.y, l.t.z});
   }
 
-  if (progress) progress->setTotal(double(bytes.total()));
+  if (progress) progress->setTotal(double(bytes.total() - bytes.bounds));  // the bounds are computed later
   gpu::Buffer staging = gpu::createBuffer(
       context, std::clamp<uint64_t>(bytes.largest(), 4, std::max<uint64_t>(staging_bytes, 4)), gpu::MemoryUse::Upload);
   try {
@@ -251,8 +281,6 @@ void GpuDataset::fill(const gpu::VulkanContext& context, const Source& source, c
     throw;
   }
   gpu::destroyBuffer(context, staging);
-  computeFibletBounds(context, block_buffer_.address, bounds_.address, block_.fiblet_count);
-  if (progress) progress->add(double(bytes.bounds));
 }
 
 GpuDataset GpuDataset::upload(const gpu::VulkanContext& context, const FblFile& file, Progress* progress,

@@ -9,9 +9,12 @@
 // the device is not implemented yet.
 //
 // Sections are copied through one bounded staging buffer, so a 10 GB
-// section needs no 10 GB of host-visible memory. After the copies a compute
-// pass decodes every fiblet once into its bounding sphere (16 bytes per
-// fiblet, render/gpu_fiblet_bounds.h), which the cull reads.
+// section needs no 10 GB of host-visible memory. The bounds buffer (16
+// bytes per fiblet, render/gpu_fiblet_bounds.h) is allocated with the rest
+// but filled only when the occlusion cull first needs it: decoding every
+// fiblet takes ~1 us a fiblet on lavapipe (0.3 s for the 246 MB tckgen
+// file), which a one-frame `render` with frustum culling, or a viewer's
+// upload on the main thread, should not pay.
 #pragma once
 
 #include <cstdint>
@@ -25,6 +28,7 @@
 #include "core/progress.h"
 #include "gpu/buffer.h"
 #include "gpu/vulkan_context.h"
+#include "render/gpu_fiblet_bounds.h"
 #include "shared/fiblet_dataset.h"
 
 namespace fibscope {
@@ -115,9 +119,21 @@ class GpuDataset {
   // vec4 per fiblet: world centre and radius (< 0: draws nothing).
   const gpu::Buffer& fibletBounds() const { return bounds_; }
 
-  // Whether the block names the bounds buffer (true after upload). False
-  // makes the cull fall back to the looser bound from the record, for
-  // comparisons; rewrites the block buffer, so the GPU must not be using it.
+  // Whether the spheres have been computed (computeFibletBounds, or a
+  // frame's recordFibletBoundsOnce).
+  bool fibletBoundsReady() const { return bounds_ready_; }
+  // Computes the spheres now (one submission, waits) and points the block
+  // at them.
+  void computeFibletBounds();
+  // For the frame renderer, before its first occlusion cull of this
+  // dataset: records the pass that fills the spheres and the update of the
+  // block's fiblet_bounds, with the barriers for the cull that follows, and
+  // counts them as ready (the caller submits `cmd`). Nothing when ready.
+  // Logically const: the spheres are a cache of the records.
+  void recordFibletBoundsOnce(VkCommandBuffer cmd, const FibletBoundsPass& pass) const;
+  // Whether the block names the (computed) bounds buffer. False makes the
+  // cull fall back to the looser bound from the record, for comparisons;
+  // rewrites the block buffer, so the GPU must not be using it.
   void useFibletBounds(bool use);
 
  private:
@@ -128,7 +144,10 @@ class GpuDataset {
 
   const gpu::VulkanContext* context_ = nullptr;
   gpu::Buffer records_, fiblet_fiber_, directions_, fiber_first_fiblet_, fiber_length_, block_buffer_, bounds_;
-  shader::FibletDataset block_{};
+  // The block as on the device: fiblet_bounds is 0 until the spheres are
+  // computed (mutable with bounds_ready_: recordFibletBoundsOnce).
+  mutable shader::FibletDataset block_{};
+  mutable bool bounds_ready_ = false;
 };
 
 }  // namespace fibscope

@@ -18,6 +18,7 @@ FrameRenderer::FrameRenderer(const gpu::VulkanContext& context, uint32_t width, 
     targets_ = createFrameTargets(context, width, height);
     fiblet_passes_ = createFibletPasses(context);
     cull_passes_ = createCullPasses(context);
+    bounds_pass_ = createFibletBoundsPass(context);
     raw_passes_ = createRawPasses(context);
     shade_pass_ = createShadePass(context, width, height);
     scene_table_ = createSceneTableBuffer(context);
@@ -37,6 +38,7 @@ void FrameRenderer::release() {
   destroyLinesPass(context_, lines_pass_);
   destroyRawPasses(context_, raw_passes_);
   destroyCullBuffers(context_, cull_buffers_);
+  destroyFibletBoundsPass(context_, bounds_pass_);
   destroyCullPasses(context_, cull_passes_);
   destroyFibletPasses(context_, fiblet_passes_);
   destroyFrameTargets(context_, targets_);
@@ -131,6 +133,18 @@ void FrameRenderer::record(VkCommandBuffer cmd, const Camera& camera, const Rend
       tangent_cache_for_ = layout_.fiblets;
     }
     cull_stats_pending_ = settings.culling != CullingMode::None && pending_.fiblets_total > 0;
+    if (settings.culling == CullingMode::TwoPhase) {
+      // The occlusion test wants each dataset's exact spheres: computed in
+      // this frame for a dataset that has none yet (frustum culling keeps
+      // the record's looser bound; see gpu_dataset.h for why not at upload).
+      bool missing = false;
+      for (const SceneEntry& e : layout_.entries) missing |= !e.dataset->fibletBoundsReady();
+      if (missing) {
+        gpu::beginPass(cmd, timer_, "fiblet bounds");
+        for (const SceneEntry& e : layout_.entries) e.dataset->recordFibletBoundsOnce(cmd, bounds_pass_);
+        gpu::endPass(cmd, timer_);
+      }
+    }
     if (cull_stats_pending_) {
       // Cull passes, both rasters (and the pyramid and second phase for
       // TwoPhase) of every dataset; fiblets_drawn and fiblets_lod come from

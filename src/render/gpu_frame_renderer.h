@@ -91,6 +91,7 @@ class FrameRenderer {
   // The scene fiblet total targets_.tangents was prepared for (UINT64_MAX:
   // none yet).
   uint64_t tangent_cache_for_ = UINT64_MAX;
+  FibletBoundsPass bounds_pass_;  // fills a dataset's spheres before its first occlusion cull
   RawPasses raw_passes_;
   LinesPass lines_pass_;  // created at the first lines frame
   ShadePass shade_pass_;

@@ -45,6 +45,8 @@ class GpuFibletBounds : public test::GpuTest {
  protected:
   void upload(const Tractogram& fibers) {
     upload_ = std::make_unique<TractogramUpload>(uploadTractogram(context(), fibers, "phantom"));
+    ASSERT_FALSE(dataset().fibletBoundsReady()) << "not at upload: when the occlusion cull first needs them";
+    dataset().computeFibletBounds();
     const shader::FibletDataset& block = dataset().block();
     const uint32_t record_bytes = upload_->params.recordBytes();
     records_.resize(size_t(block.fiblet_count) * record_bytes);
@@ -252,6 +254,47 @@ TEST_F(GpuFibletBounds, cullingWithAndWithoutSpheresDrawsTheSameFrames) {
     EXPECT_LE(drawn[0], drawn[1]) << "tighter spheres never draw more";
   }
   dataset().useFibletBounds(true);
+}
+
+// The spheres cost a decode of every fiblet (about 1 us a fiblet on
+// lavapipe), so they are not made at upload: the first frame that culls by
+// occlusion records them; frames with frustum culling (a one-frame render)
+// never pay for them. The spheres made in a frame equal those computed
+// alone.
+TEST_F(GpuFibletBounds, theFirstOcclusionCulledFrameComputesTheSpheres) {
+  const Tractogram fibers = test::renderPhantom(300, 5);
+  TractogramUpload lazy = uploadTractogram(context(), fibers, "phantom");
+  ASSERT_FALSE(lazy.dataset.fibletBoundsReady());
+  EXPECT_EQ(lazy.dataset.block().fiblet_bounds, 0u);
+  const Camera camera = orbitCamera(tractogramBounds(fibers), 40, 15, kSize, kSize, 1.0);
+  RenderSettings settings;
+  settings.ssao = false;
+  FrameRenderer renderer(context(), kSize, kSize);
+  settings.culling = CullingMode::Frustum;
+  renderer.render(camera, settings, GpuScene{&lazy.dataset});
+  EXPECT_FALSE(lazy.dataset.fibletBoundsReady()) << "frustum culling keeps the record's bound";
+  settings.culling = CullingMode::TwoPhase;
+  const FrameStats stats = renderer.render(camera, settings, GpuScene{&lazy.dataset});
+  ASSERT_TRUE(lazy.dataset.fibletBoundsReady());
+  EXPECT_EQ(lazy.dataset.block().fiblet_bounds, lazy.dataset.fibletBounds().address);
+  bool timed = false;
+  for (const auto& pass : stats.passes) timed |= pass.name == "fiblet bounds";
+  EXPECT_TRUE(timed) << "the frame that made them times them";
+  // The block on the device names the spheres too.
+  shader::FibletDataset on_device{};
+  gpu::downloadFromBuffer(context(), lazy.dataset.blockBuffer(), &on_device, sizeof on_device);
+  EXPECT_EQ(on_device.fiblet_bounds, lazy.dataset.fibletBounds().address);
+  // Bit for bit what the stand-alone computation gives.
+  const uint32_t n = lazy.dataset.block().fiblet_count;
+  std::vector<shader::vec4> in_frame(n), alone(n);
+  gpu::downloadFromBuffer(context(), lazy.dataset.fibletBounds(), in_frame.data(), n * sizeof(shader::vec4));
+  upload(fibers);  // the fixture's dataset, computed by computeFibletBounds
+  ASSERT_EQ(dataset().block().fiblet_count, n);
+  gpu::downloadFromBuffer(context(), dataset().fibletBounds(), alone.data(), n * sizeof(shader::vec4));
+  EXPECT_EQ(std::memcmp(in_frame.data(), alone.data(), n * sizeof(shader::vec4)), 0);
+  // A later two-phase frame does not make them again.
+  const FrameStats later = renderer.render(camera, settings, GpuScene{&lazy.dataset});
+  for (const auto& pass : later.passes) EXPECT_NE(pass.name, "fiblet bounds");
 }
 
 }  // namespace
