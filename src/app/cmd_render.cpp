@@ -17,7 +17,7 @@
 #include "core/error.h"
 #include "render/camera.h"
 #include "render/gpu_frame_renderer.h"
-#include "render/reference_raster.h"
+#include "render/png_writer.h"
 
 namespace fibscope {
 namespace {

@@ -89,9 +89,4 @@ ReferenceFrame rasterizeReference(const Tractogram& tractogram, const Camera& ca
 // row-major RGBA8, top row first.
 std::vector<uint8_t> shadeOrientation(const ReferenceFrame& frame);
 
-// Writes an 8-bit RGBA PNG (zlib-compressed, no filtering; bands of rows
-// deflated on every core). `rgba` holds
-// width * height * 4 bytes, top row first. Throws Error naming the path.
-void writePngRgba(const std::string& path, uint32_t width, uint32_t height, const std::vector<uint8_t>& rgba);
-
 }  // namespace fibscope

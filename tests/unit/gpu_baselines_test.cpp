@@ -26,6 +26,7 @@
 #include "render/gpu_lines_pass.h"
 #include "render/gpu_raw_tractogram.h"
 #include "render/image_compare.h"
+#include "render/png_writer.h"
 #include "render/reference_raster.h"
 #include "shared/render_config.h"
 

@@ -40,7 +40,7 @@
 #include "render/gpu_scene_table.h"
 #include "render/gpu_upscale_pass.h"
 #include "render/orbit_controller.h"
-#include "render/reference_raster.h"
+#include "render/png_writer.h"
 
 namespace fibscope {
 namespace {
