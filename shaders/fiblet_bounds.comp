@@ -1,5 +1,6 @@
 // Exact bounding spheres of the fiblets (DESIGN.md section 6, step 1), run
-// once per dataset after its upload (render/gpu_fiblet_bounds.h): one
+// once per dataset, in the first frame that culls by occlusion
+// (render/gpu_fiblet_bounds.h, GpuDataset::recordFibletBoundsOnce): one
 // invocation per fiblet decodes it front to back exactly as
 // fiblet_raster_serial.comp does (W_1, then W_1 L_2 ... L_k, points in
 // normalised units, then fibletToWorld) and writes one vec4 to the
@@ -58,7 +59,7 @@ void main() {
   vec3 lo = min(p0, q), hi = max(p0, q);
   FibletTransform s = fibletInitialTransform(p0_n, p1_n, v);
   for (uint k = 0u; k + 1u < count; ++k) {
-    if (k > 0u) s = fibletCompose(s, fibletTableTransform(directions, fibletRecordByte(records, base, fibletCodeByte(k + 1u))));
+    if (k > 0u) s = fibletNextTransform(s, directions, records, base, k);
     const vec3 p = fibletToWorld(ds, s.t);
     lo = min(lo, p);
     hi = max(hi, p);
@@ -70,7 +71,7 @@ void main() {
   float far2 = max(dot(p0 - centre, p0 - centre), dot(q - centre, q - centre));
   s = fibletInitialTransform(p0_n, p1_n, v);
   for (uint k = 0u; k + 1u < count; ++k) {
-    if (k > 0u) s = fibletCompose(s, fibletTableTransform(directions, fibletRecordByte(records, base, fibletCodeByte(k + 1u))));
+    if (k > 0u) s = fibletNextTransform(s, directions, records, base, k);
     const vec3 d = fibletToWorld(ds, s.t) - centre;
     far2 = max(far2, dot(d, d));
   }

@@ -62,7 +62,7 @@ void main() {
   const uint used = count - 1u;
   FibletTransform s = fibletInitialTransform(p0, p1, v);
   for (uint k = 0u; k < used; ++k) {
-    if (k > 0u) s = fibletCompose(s, fibletTableTransform(directions, fibletRecordByte(records, base, fibletCodeByte(k + 1u))));
+    if (k > 0u) s = fibletNextTransform(s, directions, records, base, k);
     const vec3 b_world = fibletToWorld(ds, s.t);
     const vec4 b = cameraTransformPoint(cam.view_projection, b_world);
     rasterClipSegment(vis, cam, a, b, fiblet_key | uint64_t(k));

@@ -68,8 +68,7 @@ void main() {
         const uint last = min(segment + 1u, count - 1u);
         for (uint k = 2u; k <= last; ++k) {
           a = w.t;
-          w = fibletCompose(w, fibletTableTransform(DirectionsRef(ds.directions),
-                                                    fibletRecordByte(records, base, fibletCodeByte(k))));
+          w = fibletNextTransform(w, DirectionsRef(ds.directions), records, base, k - 1u);
         }
         if (segment + 1u < count) {
           if (segment == 0u) a = p0;

@@ -34,6 +34,14 @@ FibletTransform fibletTableTransform(DirectionsRef table, uint code) {
   return l;
 }
 
+// One step of the serial decode: W_{k+1} = W_k L_{k+1} (k >= 1), from
+// W_1 = fibletInitialTransform(p0, p1, V); the translation of W_k is point
+// k. The order of composition every serial decoder (rasters, bounds,
+// resolve) shares, so their points agree bit for bit.
+FibletTransform fibletNextTransform(FibletTransform w, DirectionsRef table, WordsRef records, uint base, uint k) {
+  return fibletCompose(w, fibletTableTransform(table, fibletRecordByte(records, base, fibletCodeByte(k + 1u))));
+}
+
 // Normalised -> world mm (FibletDataset: p_mm = translation + mm_per_unit * p_n).
 vec3 fibletToWorld(FibletDataset ds, vec3 p) {
   return vec3(ds.translation_x, ds.translation_y, ds.translation_z) + ds.mm_per_unit * p;
