@@ -179,11 +179,8 @@ void prepareCullBuffers(const gpu::VulkanContext& context, CullBuffers& buffers,
   }
   list_bytes = std::max<VkDeviceSize>(list_bytes, sizeof(shader::FibletListHeader));
   visible_bytes = std::max<VkDeviceSize>(visible_bytes, 4);
-  // Another layout moves the regions: the bits no longer describe them.
-  bool same_layout = regions.size() == buffers.regions.size();
-  for (size_t i = 0; same_layout && i < regions.size(); ++i)
-    same_layout = regions[i].fiblets == buffers.regions[i].fiblets;
-  if (!same_layout) buffers.history_valid = false;
+  // (Another layout moves the regions; recordCulledRaster's sameScene
+  // check then resets the history.)
   buffers.regions = std::move(regions);
   try {
     if (!buffers.stats.buffer)
