@@ -56,8 +56,8 @@ CULL_CONST float kCullDepthSlack = 1.0e-5f;
 // rounding. Each composition rounds the translation (|t| <= sqrt(3) in
 // normalised units) by a few ulps, about 8e-7; over at most 59
 // compositions that is 5e-5 even if every rounding went the same way
-// (FibletDecoder tests scan against sequential within 1e-6 of the scene
-// size on real data; the rotations' rounding moves points by a relative
+// (fiblet_decode_test.cpp holds both orders within 2e-6 of a double
+// reference, in normalised units, on random records; the rotations' rounding moves points by a relative
 // amount of the distance travelled, which kCullRadiusSlack covers). The
 // world transform rounds each coordinate by an ulp of its magnitude, 1e-7
 // of the reach. 1e-4 is twice the worst case of both, and still only

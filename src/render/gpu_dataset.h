@@ -89,8 +89,8 @@ class GpuDataset {
   // the device's own, for tests), when a section is missing, of the wrong
   // type or size, or fails its checksum, or when fiber_first_fiblet is not
   // increasing from 0 to the fiblet count. `progress` (optional) counts the
-  // bytes uploaded (and the fiblet bounds' bytes once computed); sections
-  // are copied `staging_bytes` at a time.
+  // bytes uploaded (not the bounds buffer: filled on the device later);
+  // sections are copied `staging_bytes` at a time.
   static GpuDataset upload(const gpu::VulkanContext& context, const FblFile& file, Progress* progress = nullptr,
                            const DeviceLimits* limits = nullptr, uint64_t staging_bytes = kDatasetStagingBytes);
 

@@ -1,5 +1,6 @@
 // Exact per-fiblet bounding spheres (shaders/fiblet_bounds.comp), computed
-// once per dataset after its upload and read by the cull
+// once per dataset (in the first frame that culls by occlusion, see
+// render/gpu_dataset.h) and read by the cull
 // (fiblet_cull.comp) through FibletDataset::fiblet_bounds.
 //
 // Why: the record alone only bounds a fiblet by a sphere around its first
@@ -37,8 +38,8 @@ void recordFibletBounds(VkCommandBuffer cmd, const gpu::VulkanContext& context, 
                         VkDeviceAddress dataset, VkDeviceAddress bounds, uint32_t fiblets);
 
 // Creates the pipeline, computes the bounds in one submission (after a
-// barrier from earlier transfers), waits and destroys the pipeline: for a
-// dataset just uploaded. Throws Error when the device is lost.
+// barrier from earlier transfers), waits and destroys the pipeline
+// (GpuDataset::computeFibletBounds). Throws Error when the device is lost.
 void computeFibletBounds(const gpu::VulkanContext& context, VkDeviceAddress dataset, VkDeviceAddress bounds,
                          uint32_t fiblets);
 
