@@ -96,13 +96,9 @@ void runRender(const RenderCommandOptions& o) {
   applyScalarColoring(context, scene.fiblets, o.render, settings, gpu_scene);
   const Camera camera = cameraFor(o, scene, width, height);
   auto t = Clock::now();
-  FrameStats stats;
-  std::vector<uint8_t> rgba;
-  {
-    FrameRenderer& renderer = *device->renderer;
-    stats = renderer.render(camera, settings, gpu_scene);
-    rgba = downloadColor(context, renderer.targets());
-  }
+  FrameRenderer& renderer = *device->renderer;
+  const FrameStats stats = renderer.render(camera, settings, gpu_scene);
+  const std::vector<uint8_t> rgba = downloadColor(context, renderer.targets());
   const double frame_seconds = secondsSince(t);
   t = Clock::now();
   writePngRgba(o.output, width, height, rgba);
