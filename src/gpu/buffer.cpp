@@ -99,6 +99,7 @@ Buffer createBuffer(const VulkanContext& context, VkDeviceSize size, MemoryUse u
     vkGetBufferMemoryRequirements(context.device(), buffer.buffer, &requirements);
     VkMemoryPropertyFlags properties = 0;
     buffer.memory = allocateMemory(context, requirements, use, true, &properties);
+    buffer.memory_properties = properties;
     VK_CHECK(vkBindBufferMemory(context.device(), buffer.buffer, buffer.memory, 0));
     if (use != MemoryUse::DeviceLocal) {
       throwIfFailed(vkMapMemory(context.device(), buffer.memory, 0, VK_WHOLE_SIZE, 0, &buffer.mapped), "vkMapMemory");
@@ -113,6 +114,19 @@ Buffer createBuffer(const VulkanContext& context, VkDeviceSize size, MemoryUse u
   buffer.address = vkGetBufferDeviceAddress(context.device(), &address);
   return buffer;
 }
+
+void* mapForDirectWrite(const VulkanContext& context, const Buffer& buffer) {
+  const VkPhysicalDeviceType type = context.info().type;
+  if (type != VK_PHYSICAL_DEVICE_TYPE_CPU && type != VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU) return nullptr;
+  constexpr VkMemoryPropertyFlags kNeeded = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+  if (buffer.memory == VK_NULL_HANDLE || buffer.mapped || (buffer.memory_properties & kNeeded) != kNeeded)
+    return nullptr;
+  void* mapped = nullptr;
+  if (vkMapMemory(context.device(), buffer.memory, 0, VK_WHOLE_SIZE, 0, &mapped) != VK_SUCCESS) return nullptr;
+  return mapped;
+}
+
+void unmapBuffer(const VulkanContext& context, const Buffer& buffer) { vkUnmapMemory(context.device(), buffer.memory); }
 
 void destroyBuffer(const VulkanContext& context, Buffer& buffer) {
   if (buffer.buffer != VK_NULL_HANDLE) vkDestroyBuffer(context.device(), buffer.buffer, nullptr);

@@ -27,6 +27,7 @@ struct Buffer {
   VkDeviceAddress address = 0;  // for buffer references in shaders
   void* mapped = nullptr;       // Upload and Readback buffers
   bool coherent = false;        // mapped memory needs no flush/invalidate
+  VkMemoryPropertyFlags memory_properties = 0;  // of the memory type chosen
 };
 
 // Memory of a type allowed by `requirements` with the properties `use`
@@ -40,6 +41,16 @@ VkDeviceMemory allocateMemory(const VulkanContext& context, const VkMemoryRequir
 // arguments). Throws Error when size exceeds the device's largest
 // allocation or memory runs out.
 Buffer createBuffer(const VulkanContext& context, VkDeviceSize size, MemoryUse use, VkBufferUsageFlags extra_usage = 0);
+// For filling a DeviceLocal buffer the GPU has not used yet without a
+// staging copy: where the device shares the host's memory (a CPU device
+// such as lavapipe, or an integrated GPU) and the buffer's memory is
+// host-visible and coherent, maps it and returns the pointer (unmapBuffer
+// when done; writes need no flush and are visible to later submissions);
+// nullptr otherwise. Discrete GPUs keep the DMA copy: writing device
+// memory over the bus from the CPU is slower than the copy engine.
+void* mapForDirectWrite(const VulkanContext& context, const Buffer& buffer);
+void unmapBuffer(const VulkanContext& context, const Buffer& buffer);
+
 // Destroys and resets `buffer`; a default Buffer is a no-op.
 void destroyBuffer(const VulkanContext& context, Buffer& buffer);
 

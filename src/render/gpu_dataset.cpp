@@ -211,7 +211,7 @@ void GpuDataset::useFibletBounds(bool use) {
 
 // What both upload paths hand to the common part, after the size check.
 struct GpuDataset::Source {
-  std::span<const uint8_t> records;
+  ChunkSource records;  // any range, from several threads at once (uploadRandomAccess)
   FiberTables tables;
   std::span<const float> fiber_length_mm;
   CodecParams params;
@@ -265,17 +265,25 @@ void GpuDataset::fill(const gpu::VulkanContext& context, const Source& source, c
   }
 
   if (progress) progress->setTotal(double(bytes.total() - bytes.bounds));  // the bounds are computed later
-  gpu::Buffer staging = gpu::createBuffer(
-      context, std::clamp<uint64_t>(bytes.largest(), 4, std::max<uint64_t>(staging_bytes, 4)), gpu::MemoryUse::Upload);
+  // The staging buffer only where a buffer cannot be written directly
+  // (discrete GPUs); CPU and integrated devices take the bytes in place.
+  gpu::Buffer staging;
+  const auto stage = [&]() -> const gpu::Buffer& {
+    if (staging.buffer == VK_NULL_HANDLE)
+      staging = gpu::createBuffer(context, std::clamp<uint64_t>(bytes.largest(), 4, std::max<uint64_t>(staging_bytes, 4)),
+                                  gpu::MemoryUse::Upload);
+    return staging;
+  };
   try {
-    uploadChunked(context, staging, records_, bytes.records, bytesOf(source.records.data()), progress);
-    uploadChunked(context, staging, fiblet_fiber_, bytes.fiblet_fiber, bytesOf(source.tables.fiblet_fiber.data()),
-                  progress);
-    uploadChunked(context, staging, directions_, bytes.directions, bytesOf(table.data()), progress);
-    uploadChunked(context, staging, fiber_first_fiblet_, bytes.fiber_first_fiblet, bytesOf(source.tables.first.data()),
-                  progress);
-    uploadChunked(context, staging, fiber_length_, bytes.fiber_length, bytesOf(source.fiber_length_mm.data()), progress);
-    uploadChunked(context, staging, block_buffer_, bytes.block, bytesOf(&block_), progress);
+    uploadRandomAccess(context, stage, records_, bytes.records, source.records, progress);
+    uploadRandomAccess(context, stage, fiblet_fiber_, bytes.fiblet_fiber, bytesOf(source.tables.fiblet_fiber.data()),
+                       progress);
+    uploadRandomAccess(context, stage, directions_, bytes.directions, bytesOf(table.data()), progress);
+    uploadRandomAccess(context, stage, fiber_first_fiblet_, bytes.fiber_first_fiblet,
+                       bytesOf(source.tables.first.data()), progress);
+    uploadRandomAccess(context, stage, fiber_length_, bytes.fiber_length, bytesOf(source.fiber_length_mm.data()),
+                       progress);
+    uploadRandomAccess(context, stage, block_buffer_, bytes.block, bytesOf(&block_), progress);
   } catch (...) {
     gpu::destroyBuffer(context, staging);
     throw;
@@ -321,7 +329,7 @@ GpuDataset GpuDataset::upload(const gpu::VulkanContext& context, const FblFile& 
 
   source.tables = deriveFiberTables(name, file.array<uint64_t>(first_section), fiblets);
   source.fiber_length_mm = file.array<float>(length_section);
-  source.records = file.data(fiblet_section);
+  source.records = bytesOf(file.data(fiblet_section).data());
 
   GpuDataset dataset;
   dataset.fill(context, source, bytes, progress, staging_bytes);
@@ -332,17 +340,32 @@ GpuDataset GpuDataset::upload(const gpu::VulkanContext& context, const EncodedFi
                               const CodecParams& params, std::span<const float> fiber_length_mm,
                               const std::string& name, Progress* progress, const DeviceLimits* limits,
                               uint64_t staging_bytes) {
+  const EncodedFiblets* const whole = &fiblets;
+  return upload(context, std::span<const EncodedFiblets* const>(&whole, 1), params, fiber_length_mm, name, progress,
+                limits, staging_bytes);
+}
+
+GpuDataset GpuDataset::upload(const gpu::VulkanContext& context, std::span<const EncodedFiblets* const> parts,
+                              const CodecParams& params, std::span<const float> fiber_length_mm,
+                              const std::string& name, Progress* progress, const DeviceLimits* limits,
+                              uint64_t staging_bytes) {
   validateCodecParams(params);
-  if (fiblets.fiblet_base != 0)
-    fail(name, "the fiblets start at global index " + std::to_string(fiblets.fiblet_base) +
-                   ": only whole tractograms can be uploaded");
   const uint32_t record_bytes = params.recordBytes();
-  if (fiblets.record_bytes != record_bytes || fiblets.bytes.size() % record_bytes != 0)
-    fail(name, std::to_string(fiblets.bytes.size()) + " bytes of " + std::to_string(fiblets.record_bytes) +
-                   "-byte records, expected whole " + std::to_string(record_bytes) +
-                   "-byte records for N = " + std::to_string(params.points_per_fiblet));
-  const uint64_t count = fiblets.fibletCount();
-  const uint64_t fibers = fiblets.fiber_first_fiblet.size();
+  uint64_t count = 0, fibers = 0;
+  // Where each part's records start in the joined records (parts + 1).
+  std::vector<uint64_t> part_begin{0};
+  for (const EncodedFiblets* part : parts) {
+    if (part->fiblet_base != 0)
+      fail(name, "the fiblets start at global index " + std::to_string(part->fiblet_base) +
+                     ": only whole tractograms can be uploaded");
+    if (part->record_bytes != record_bytes || part->bytes.size() % record_bytes != 0)
+      fail(name, std::to_string(part->bytes.size()) + " bytes of " + std::to_string(part->record_bytes) +
+                     "-byte records, expected whole " + std::to_string(record_bytes) +
+                     "-byte records for N = " + std::to_string(params.points_per_fiblet));
+    count += part->fibletCount();
+    fibers += part->fiber_first_fiblet.size();
+    part_begin.push_back(part_begin.back() + part->bytes.size());
+  }
   if (fiber_length_mm.size() != fibers)
     fail(name, std::to_string(fiber_length_mm.size()) + " fiber lengths for " + std::to_string(fibers) + " fibers");
   const DatasetBytes bytes = datasetBytes(fibers, count, record_bytes);
@@ -350,11 +373,29 @@ GpuDataset GpuDataset::upload(const gpu::VulkanContext& context, const EncodedFi
 
   Source source;
   source.params = params;
-  std::vector<uint32_t> first(fiblets.fiber_first_fiblet);
-  first.push_back(uint32_t(count));  // < 2^32: checked above
+  std::vector<uint32_t> first;
+  first.reserve(fibers + 1);
+  uint64_t base = 0;
+  for (const EncodedFiblets* part : parts) {
+    for (uint32_t f : part->fiber_first_fiblet) first.push_back(uint32_t(base + f));  // < 2^32: checked above
+    base += part->fibletCount();
+  }
+  first.push_back(uint32_t(count));
   source.tables = deriveFiberTables(name, std::span<const uint32_t>(first), count);
   source.fiber_length_mm = fiber_length_mm;
-  source.records = fiblets.bytes;
+  // The joined records, read from the parts.
+  source.records = [parts, &part_begin](uint8_t* out, uint64_t offset, uint64_t n) {
+    size_t p = size_t(std::upper_bound(part_begin.begin(), part_begin.end(), offset) - part_begin.begin()) - 1;
+    while (n > 0) {
+      const uint64_t within = offset - part_begin[p];
+      const uint64_t take = std::min(n, part_begin[p + 1] - offset);
+      std::memcpy(out, parts[p]->bytes.data() + within, size_t(take));
+      out += take;
+      offset += take;
+      n -= take;
+      ++p;
+    }
+  };
 
   GpuDataset dataset;
   dataset.fill(context, source, bytes, progress, staging_bytes);

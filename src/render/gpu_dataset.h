@@ -101,6 +101,14 @@ class GpuDataset {
                            std::span<const float> fiber_length_mm, const std::string& name,
                            Progress* progress = nullptr, const DeviceLimits* limits = nullptr,
                            uint64_t staging_bytes = kDatasetStagingBytes);
+  // The same for a tractogram encoded in parts (consecutive runs of whole
+  // fibers encoded apart, in order, each part's fiber_first_fiblet counted
+  // from its own first record), uploaded as if joined, without joining
+  // them in memory first.
+  static GpuDataset upload(const gpu::VulkanContext& context, std::span<const EncodedFiblets* const> parts,
+                           const CodecParams& params, std::span<const float> fiber_length_mm,
+                           const std::string& name, Progress* progress = nullptr,
+                           const DeviceLimits* limits = nullptr, uint64_t staging_bytes = kDatasetStagingBytes);
 
   // The block as uploaded (addresses of this dataset's buffers).
   const shader::FibletDataset& block() const { return block_; }

@@ -2,6 +2,10 @@
 
 #include <algorithm>
 #include <cstring>
+#include <future>
+#include <vector>
+
+#include "core/thread_pool.h"
 
 #include "gpu/submit.h"
 #include "gpu/vk_check.h"
@@ -37,6 +41,38 @@ void uploadChunked(const gpu::VulkanContext& context, const gpu::Buffer& staging
     offset += chunk;
     if (progress) progress->add(double(chunk));
   }
+}
+
+void uploadRandomAccess(const gpu::VulkanContext& context, const std::function<const gpu::Buffer&()>& staging,
+                        const gpu::Buffer& destination, uint64_t bytes, const ChunkSource& source, Progress* progress) {
+  if (bytes == 0) return;
+  uint8_t* mapped = static_cast<uint8_t*>(gpu::mapForDirectWrite(context, destination));
+  if (!mapped) {
+    uploadChunked(context, staging(), destination, bytes, source, progress);
+    return;
+  }
+  constexpr uint64_t kRound = uint64_t(64) << 20;  // progress steps
+  constexpr uint64_t kMinPiece = uint64_t(4) << 20;  // smaller is not worth a thread
+  const uint64_t threads = std::max(1u, ThreadPool::hardwareThreads());
+  try {
+    for (uint64_t round = 0; round < bytes; round += kRound) {
+      const uint64_t round_bytes = std::min(kRound, bytes - round);
+      const uint64_t pieces = std::clamp<uint64_t>(round_bytes / kMinPiece, 1, threads);
+      const uint64_t piece = (round_bytes + pieces - 1) / pieces;
+      std::vector<std::future<void>> helpers;
+      for (uint64_t begin = round + piece; begin < round + round_bytes; begin += piece) {
+        const uint64_t n = std::min(piece, round + round_bytes - begin);
+        helpers.push_back(std::async(std::launch::async, [&source, mapped, begin, n] { source(mapped + begin, begin, n); }));
+      }
+      source(mapped + round, round, std::min(piece, round_bytes));
+      for (auto& helper : helpers) helper.get();
+      if (progress) progress->add(double(round_bytes));
+    }
+  } catch (...) {
+    gpu::unmapBuffer(context, destination);
+    throw;
+  }
+  gpu::unmapBuffer(context, destination);
 }
 
 }  // namespace fibscope

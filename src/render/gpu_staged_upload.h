@@ -28,4 +28,15 @@ ChunkSource bytesOf(const void* data);
 void uploadChunked(const gpu::VulkanContext& context, const gpu::Buffer& staging, const gpu::Buffer& destination,
                    uint64_t bytes, const ChunkSource& source, Progress* progress, uint64_t destination_offset = 0);
 
+// As uploadChunked, for a source that may be asked for any range, in any
+// order and from several threads at once (bytesOf is): where
+// gpu::mapForDirectWrite maps `destination` (CPU and integrated devices),
+// the source writes straight into it, each 64 MiB spread over the hardware
+// threads (the first-touch page faults of the fresh memory too), with no
+// staging copy and no submission; otherwise uploadChunked through the
+// buffer `staging()` returns (so a caller can make it on first need).
+// `destination` must not be in use by the GPU.
+void uploadRandomAccess(const gpu::VulkanContext& context, const std::function<const gpu::Buffer&()>& staging,
+                        const gpu::Buffer& destination, uint64_t bytes, const ChunkSource& source, Progress* progress);
+
 }  // namespace fibscope

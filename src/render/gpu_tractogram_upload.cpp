@@ -17,32 +17,18 @@ namespace {
 // Chunks of about this many points go to the workers, each copied into the
 // worker's reused chunk (encode() runs two fibers at once, 1.5x the speed
 // of one fiber at a time) and encoded into its own EncodedFiblets; the
-// parts are then joined in order.
+// parts are uploaded in order, never joined in memory.
 constexpr size_t kEncodeChunkPoints = size_t(1) << 18;
 
-// Joins encoded parts (in input order) into one EncodedFiblets.
-EncodedFiblets joinParts(std::deque<EncodedFiblets>& parts, uint32_t record_bytes) {
-  EncodedFiblets all;
-  all.record_bytes = record_bytes;
-  size_t bytes = 0, fibers = 0;
-  for (const EncodedFiblets& part : parts) {
-    bytes += part.bytes.size();
-    fibers += part.fiberCount();
-  }
-  all.bytes.reserve(bytes);
-  all.fiber_first_fiblet.reserve(fibers);
-  all.fiber_points.reserve(fibers);
-  for (EncodedFiblets& part : parts) {
-    const uint32_t base = uint32_t(all.fibletCount());
-    all.bytes.insert(all.bytes.end(), part.bytes.begin(), part.bytes.end());
-    for (uint32_t first : part.fiber_first_fiblet) all.fiber_first_fiblet.push_back(base + first);
-    all.fiber_points.insert(all.fiber_points.end(), part.fiber_points.begin(), part.fiber_points.end());
-    part = {};
-  }
-  return all;
+// The parts as GpuDataset::upload takes them (in input order).
+std::vector<const EncodedFiblets*> partList(const std::deque<EncodedFiblets>& parts) {
+  std::vector<const EncodedFiblets*> list;
+  for (const EncodedFiblets& part : parts) list.push_back(&part);
+  return list;
 }
 
-EncodedFiblets encodeInParallel(const Tractogram& tractogram, const CodecParams& params) {
+// Encoded parts in input order (uploaded without joining them).
+std::deque<EncodedFiblets> encodeInParallel(const Tractogram& tractogram, const CodecParams& params) {
   // Fiber ranges of about kEncodeChunkPoints points, in order.
   std::vector<std::pair<size_t, size_t>> ranges;
   for (size_t s = 0; s < tractogram.streamlineCount();) {
@@ -69,7 +55,7 @@ EncodedFiblets encodeInParallel(const Tractogram& tractogram, const CodecParams&
     }));
   }
   for (auto& d : done) d.get();
-  return joinParts(parts, params.recordBytes());
+  return parts;
 }
 
 
@@ -180,14 +166,13 @@ StreamedUpload uploadStreamed(const ContextSource& context,
     }
   }
   for (auto& job : in_flight) job.first.get();
-  const EncodedFiblets encoded = joinParts(parts, out.upload.params.recordBytes());
   std::vector<float> all_lengths;
   all_lengths.reserve(out.streamlines);
   for (const auto& l : lengths) all_lengths.insert(all_lengths.end(), l.begin(), l.end());
   out.upload.encode_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   const gpu::VulkanContext& device = context();
   const auto t1 = Clock::now();  // not counting a wait for the device
-  out.upload.dataset = GpuDataset::upload(device, encoded, out.upload.params, all_lengths, name, progress);
+  out.upload.dataset = GpuDataset::upload(device, partList(parts), out.upload.params, all_lengths, name, progress);
   out.upload.upload_seconds = std::chrono::duration<double>(Clock::now() - t1).count();
   return out;
 }
@@ -198,10 +183,10 @@ TractogramUpload uploadTractogram(const gpu::VulkanContext& context, const Tract
   const auto t0 = Clock::now();
   TractogramUpload out;
   out.params = chooseCodecParams(tractogram);
-  const EncodedFiblets encoded = encodeInParallel(tractogram, out.params);
+  const std::deque<EncodedFiblets> parts = encodeInParallel(tractogram, out.params);
   const std::vector<float> lengths = streamlineLengths(tractogram);
   const auto t1 = Clock::now();
-  out.dataset = GpuDataset::upload(context, encoded, out.params, lengths, name, progress);
+  out.dataset = GpuDataset::upload(context, partList(parts), out.params, lengths, name, progress);
   out.encode_seconds = std::chrono::duration<double>(t1 - t0).count();
   out.upload_seconds = std::chrono::duration<double>(Clock::now() - t1).count();
   return out;
