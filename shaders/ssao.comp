@@ -1,8 +1,9 @@
 // Screen-space ambient occlusion for lines (DESIGN.md section 6, "Shading").
 // Lines have no surface normal, so instead of a normal-oriented hemisphere
 // each covered pixel looks at kSsaoSamples G-buffer neighbours on a disc of
-// radius_px around it (a Vogel spiral, rotated by a per-pixel hash so the
-// pattern's banding becomes noise the blur removes) and counts those of
+// radius_px around it (a Vogel spiral, turned by one of 16 angles set by the
+// pixel's place in a 4 x 4 tile, so neighbouring pixels sample different
+// directions and the 5-tap blur averages all 16) and counts those of
 // OTHER fibers that lie nearer the camera, as line renderers with depth
 // cues do (e.g. the fiblets paper's fig. 1): a fiber behind or inside a
 // bundle darkens, the front of a bundle does not.
@@ -43,7 +44,11 @@ void main() {
   if (centre.fiber != kNoFiberId && pc.radius_px > 0.0 && pc.strength > 0.0) {
     const CameraBlock cam = CameraRef(pc.camera).camera;
     const float z = viewDistance(cam, centre.depth);
-    const float rotation = float(shadeHash(p.x * 0x9E3779B1u ^ p.y * 0x85EBCA77u) >> 8) * (6.28318531 / 16777216.0);
+    // A 4 x 4 Bayer matrix: consecutive angles as far apart in the tile as
+    // they can be, so even a partial blur (at a depth edge) mixes spread
+    // directions.
+    const uint bayer = ((p.x ^ p.y) & 1u) << 3 | (p.y & 1u) << 2 | ((p.x ^ p.y) & 2u) | (p.y & 2u) >> 1;
+    const float rotation = (float(bayer) + 0.5) * (6.28318531 / float(kSsaoRotations));
     // Scale k samples a disc 2^k times wider; the factors multiply.
     for (uint k = 0u; k < pc.scales; ++k) {
       const float radius = pc.radius_px * float(1u << k);

@@ -1,8 +1,9 @@
 // One direction of the depth-aware separable blur of the SSAO factor
-// (ssao.comp): a 2 * kSsaoBlurRadius + 1 tap Gaussian along (step_x,
-// step_y) over covered pixels whose view depth lies within
-// depth_tolerance_mm of the centre's, so the per-pixel rotation noise is
-// smoothed along and across a bundle without bleeding between fibers far
+// (ssao.comp): 5 taps weighted 1 2 2 2 1 along (step_x, step_y), over
+// covered pixels whose view depth lies within depth_tolerance_mm of the
+// centre's. The weights give each phase of ssao.comp's 4 x 4 rotation tile
+// the same total, so the x then y passes average the 16 rotations (no
+// pattern left where the depth is even) without bleeding between fibers far
 // apart in depth or into the background. Run once with (1, 0), once with
 // (0, 1). Empty pixels copy their value (1).
 #version 460
@@ -30,9 +31,7 @@ void main() {
   if (centre.fiber != kNoFiberId) {
     const CameraBlock cam = CameraRef(pc.camera).camera;
     const float z = viewDistance(cam, centre.depth);
-    // sigma = radius / 2: the outermost taps weigh e^-2.
-    const float inv_two_sigma2 = 2.0 / float(kSsaoBlurRadius * kSsaoBlurRadius);
-    float sum = result, total = 1.0;
+    float sum = 2.0 * result, total = 2.0;
     const ivec2 step = ivec2(pc.step_x, pc.step_y);
     for (int k = -int(kSsaoBlurRadius); k <= int(kSsaoBlurRadius); ++k) {
       if (k == 0) continue;
@@ -41,7 +40,7 @@ void main() {
       const uint qi = uint(q.y) * pc.width + uint(q.x);
       const GBufferTexel t = gbuffer.texels[qi];
       if (t.fiber == kNoFiberId || abs(viewDistance(cam, t.depth) - z) > pc.depth_tolerance_mm) continue;
-      const float w = exp(-float(k * k) * inv_two_sigma2);
+      const float w = abs(k) == int(kSsaoBlurRadius) ? 1.0 : 2.0;
       sum += w * ao_in.values[qi];
       total += w;
     }

@@ -36,10 +36,15 @@ SHADE_CONST float kShadeNormalParallelEps = 1e-3f;
 SHADE_CONST uint kShadeLightingNone = 0u;
 SHADE_CONST uint kShadeLightingIlluminated = 1u;
 
-// Neighbours sampled per pixel by ssao.comp (a Vogel spiral, rotated per
-// pixel), and the blur's half width in pixels.
+// Neighbours sampled per pixel by ssao.comp (a Vogel spiral, turned by one
+// of kSsaoRotations angles chosen by the pixel's place in a 4 x 4 tile:
+// interleaved sampling, Keller & Heidrich 2001), and the blur's half width
+// in pixels: 2, with weights 1 2 2 2 1, gives each of the 4 phases of the
+// tile the same weight along a row and along a column, so on a region of
+// one depth the two blur passes average the 16 rotations exactly.
 SHADE_CONST uint kSsaoSamples = 16u;
-SHADE_CONST uint kSsaoBlurRadius = 4u;
+SHADE_CONST uint kSsaoRotations = 16u;
+SHADE_CONST uint kSsaoBlurRadius = 2u;
 // RenderSettings::ao_scales at most: radii r, 2r, 4r, 8r.
 SHADE_CONST uint kSsaoMaxScales = 4u;
 
@@ -73,7 +78,7 @@ struct SsaoPush {
 };
 
 // ssao_blur.comp: ao_out = the average of ao_in over the 2 * kSsaoBlurRadius
-// + 1 pixels along (step_x, step_y), weighted by a Gaussian and counting only
+// + 1 pixels along (step_x, step_y), weighted 1 2 2 2 1 and counting only
 // covered pixels whose view depth is within depth_tolerance_mm of the
 // centre's. Empty pixels copy their value.
 struct SsaoBlurPush {
