@@ -8,7 +8,8 @@
 // occlusion factor when ssao.comp ran, unselected fibers faded towards the
 // background when there is a selection, as RGBA8 (R in the low byte,
 // A = 255). Empty pixels get the background colour. Formulas:
-// shared/shade_push.h.
+// shared/shade_push.h. One workgroup per covered tile (tile_classify.comp);
+// the other tiles hold the background already.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_buffer_reference : require
@@ -51,8 +52,8 @@ vec3 normalColor(CameraBlock cam, vec3 t, vec3 v) {
 }
 
 void main() {
-  const uvec2 p = gl_GlobalInvocationID.xy;
-  if (p.x >= pc.width || p.y >= pc.height) return;
+  uvec2 p;
+  if (!tilePixel(pc.tiles, pc.width, pc.height, p)) return;
   const uint index = p.y * pc.width + p.x;
   const GBufferTexel texel = GBufferRef(pc.gbuffer).texels[index];
   const vec3 background = unpackRgb8(pc.background);
@@ -74,7 +75,7 @@ void main() {
     else if (mode == kShadeColorPerFiber) c = fiberColor(texel.fiber);
     else if (mode == kShadeColorScalar) c = scalarColor(ScalarRef(pc.fiber_scalars).values[texel.fiber]);
     else if (mode == kShadeColorNormal) c = normalColor(cam, t, v);
-    else c = vec3(pc.solid_r, pc.solid_g, pc.solid_b);
+    else c = unpackRgb8(pc.solid);
     if (pc.lighting == kShadeLightingIlluminated) {
       const vec3 lv = normalize(vec3(kShadeLightViewX, kShadeLightViewY, kShadeLightViewZ));
       const vec3 l = lv.x * cameraRight(cam) + lv.y * cameraUp(cam) + lv.z * cameraBack(cam);

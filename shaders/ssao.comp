@@ -35,8 +35,8 @@ layout(buffer_reference, std430, buffer_reference_align = 4) buffer AoRef { floa
 const float kGoldenAngle = 2.39996323;
 
 void main() {
-  const uvec2 p = gl_GlobalInvocationID.xy;
-  if (p.x >= pc.width || p.y >= pc.height) return;
+  uvec2 p;
+  if (!tilePixel(pc.tiles, pc.width, pc.height, p)) return;
   const uint index = p.y * pc.width + p.x;
   GBufferRef gbuffer = GBufferRef(pc.gbuffer);
   const GBufferTexel centre = gbuffer.texels[index];

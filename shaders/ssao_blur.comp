@@ -21,8 +21,8 @@ layout(push_constant, std430) uniform Push { SsaoBlurPush pc; };
 layout(buffer_reference, std430, buffer_reference_align = 4) buffer AoRef { float values[]; };
 
 void main() {
-  const uvec2 p = gl_GlobalInvocationID.xy;
-  if (p.x >= pc.width || p.y >= pc.height) return;
+  uvec2 p;
+  if (!tilePixel(pc.tiles, pc.width, pc.height, p)) return;
   const uint index = p.y * pc.width + p.x;
   GBufferRef gbuffer = GBufferRef(pc.gbuffer);
   AoRef ao_in = AoRef(pc.ao_in);

@@ -24,5 +24,10 @@ layout(buffer_reference, std430, buffer_reference_align = 4) buffer FibletListRe
   FibletListHeader header;
   uint fiblets[];
 };
+// The same layout listing screen tiles (tile_classify.comp).
+layout(buffer_reference, std430, buffer_reference_align = 4) buffer TileListRef {
+  FibletListHeader header;
+  uint tiles[];
+};
 
 #endif

@@ -7,6 +7,21 @@
 
 #include "glsl/render_buffers.glsl"
 
+// The pixel of this invocation in a pass run one workgroup
+// (kPixelGroupSize x kPixelGroupSize) per listed tile (tile_classify.comp):
+// the flattened workgroup index picks the tile, the local id the pixel in
+// it. False past the list's end (the 2D grid may overshoot) and outside the
+// frame.
+bool tilePixel(uint64_t tiles, uint width, uint height, out uvec2 p) {
+  p = uvec2(0u);
+  TileListRef list = TileListRef(tiles);
+  const uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
+  if (group >= list.header.count) return false;
+  const uint tile = list.tiles[group], tiles_x = (width + kPixelGroupSize - 1u) / kPixelGroupSize;
+  p = uvec2(tile % tiles_x, tile / tiles_x) * kPixelGroupSize + gl_LocalInvocationID.xy;
+  return p.x < width && p.y < height;
+}
+
 // Distance along the view axis (mm) of clip depth d = z/w in [0, 1]:
 // camera.cpp's projection gives d = f (z - n) / ((f - n) z) for z the
 // distance, so z = n f / (f - d (f - n)).

@@ -4,6 +4,7 @@
 // names it. Buffers are device addresses; the uint64_t members come first
 // and the rest are 4-byte scalars, so std430 and C++ agree.
 //
+//   tile_classify.comp  G-buffer -> the list of 8 x 8 tiles with a covered pixel
 //   ssao.comp       G-buffer depth -> raw ambient-occlusion factor per pixel
 //   ssao_blur.comp  depth-aware separable blur of that factor (run twice: x, y)
 //   shade.comp      colour x lighting x ambient occlusion -> RGBA8
@@ -56,6 +57,23 @@ SHADE_CONST float kShadeLightViewX = -0.35f;
 SHADE_CONST float kShadeLightViewY = 0.45f;
 SHADE_CONST float kShadeLightViewZ = 1.0f;
 
+// tile_classify.comp: one invocation per pixel; the first subgroup to find
+// a covered pixel in a kPixelGroupSize x kPixelGroupSize tile sets the
+// tile's flag (flags: uint per tile, zeroed before) and appends the tile's
+// index (ty * tiles_x + tx) to `tiles` (shared/fiblet_list.h layout, count
+// zeroed before). ssao, ssao_blur and shade then run one workgroup per
+// listed tile (dispatched indirectly, the list finalised as the fiblet
+// lists are): empty tiles cost nothing there (their colour is the
+// background, filled before), which on a CPU device, whose SIMD lanes run
+// every branch, is most of a frame's pixels.
+struct TileClassifyPush {
+  uint64_t gbuffer;
+  uint64_t flags;
+  uint64_t tiles;
+  uint width;
+  uint height;
+};
+
 // ssao.comp: per covered pixel, the fraction of kSsaoSamples neighbours
 // within radius_px that lie nearer the camera than the pixel by more than
 // epsilon_mm and less than range_mm (a smooth falloff ends at range_mm),
@@ -67,6 +85,7 @@ struct SsaoPush {
   uint64_t camera;   // CameraBlock: depth_range linearises the clip depth
   uint64_t gbuffer;  // GBufferTexel per pixel
   uint64_t ao;       // float per pixel (written)
+  uint64_t tiles;    // the covered tiles (tile_classify.comp): one workgroup each
   uint width;
   uint height;
   float radius_px;
@@ -86,6 +105,7 @@ struct SsaoBlurPush {
   uint64_t gbuffer;
   uint64_t ao_in;   // float per pixel
   uint64_t ao_out;  // float per pixel (written)
+  uint64_t tiles;   // the covered tiles: one workgroup each
   uint width;
   uint height;
   int step_x;  // (1, 0): horizontal pass, (0, 1): vertical pass
@@ -96,7 +116,8 @@ struct SsaoBlurPush {
 
 // shade.comp: per pixel, base colour (color_mode) times lighting, times the
 // ambient-occlusion factor when ao != 0, packed as RGBA8 (R in the low byte,
-// A = 255); empty pixels get the background colour. Illuminated lines
+// A = 255), in the covered tiles (one workgroup each; the others hold the
+// background already); empty pixels get the background colour. Illuminated lines
 // (Zoeckler, Stalling, Hege 1996) with T the tangent, L the light and V the
 // direction towards the eye:
 //   diffuse  = sqrt(1 - (L.T)^2)
@@ -118,11 +139,12 @@ struct ShadePush {
   uint64_t colormap;        // kShadeColormapEntries RGBA8 uints: the chosen colormap's table
   uint64_t fiber_scalars;   // float per fiber, or 0
   uint64_t selection_bits;  // uint words, bit f % 32 of word f / 32; or 0: no selection
+  uint64_t tiles;           // the covered tiles (tile_classify.comp): one workgroup each
   uint width;
   uint height;
   uint color_mode;
   uint lighting;
-  float solid_r, solid_g, solid_b;
+  uint solid;       // RGBA8: the solid base colour (8 bits a channel, as the image)
   uint background;  // RGBA8 (what the image stores anyway)
   float ambient;
   float diffuse;
@@ -168,11 +190,12 @@ SHADER_NAMESPACE_END
 
 #ifdef __cplusplus
 #include <cstddef>
-static_assert(sizeof(fibscope::shader::SsaoPush) == 56, "");
-static_assert(sizeof(fibscope::shader::SsaoBlurPush) == 56, "");
+static_assert(sizeof(fibscope::shader::TileClassifyPush) == 32, "");
+static_assert(sizeof(fibscope::shader::SsaoPush) == 64, "");
+static_assert(sizeof(fibscope::shader::SsaoBlurPush) == 64, "");
 // 128 bytes: the smallest maxPushConstantsSize Vulkan guarantees.
 static_assert(sizeof(fibscope::shader::ShadePush) == 128, "");
-static_assert(offsetof(fibscope::shader::ShadePush, width) == 56, "scalars follow the seven addresses");
+static_assert(offsetof(fibscope::shader::ShadePush, width) == 64, "scalars follow the eight addresses");
 static_assert(offsetof(fibscope::shader::ShadePush, fiber_count) == 120, "");
 static_assert(sizeof(fibscope::shader::FxaaPush) == 40, "");
 #endif

@@ -10,6 +10,8 @@
 #include "gpu/submit.h"
 #include "render/colormap.h"
 #include "render/gpu_fiblet_passes.h"
+#include "shared/cull_push.h"
+#include "shared/fiblet_list.h"
 #include "shared/render_config.h"
 #include "shared/shade_push.h"
 
@@ -44,36 +46,89 @@ void end(VkCommandBuffer cmd, gpu::GpuTimer* timer) {
   if (timer) gpu::endPass(cmd, *timer);
 }
 
+uint64_t tileCount(uint32_t width, uint32_t height) {
+  return uint64_t((width + shader::kPixelGroupSize - 1) / shader::kPixelGroupSize) *
+         ((height + shader::kPixelGroupSize - 1) / shader::kPixelGroupSize);
+}
+
 void createScratch(const gpu::VulkanContext& context, ShadePass& pass, uint32_t width, uint32_t height) {
   // float and RGBA8 are both 4 bytes a pixel.
   const VkDeviceSize bytes = VkDeviceSize(width) * height * sizeof(float);
-  gpu::Buffer ao = gpu::createBuffer(context, bytes, gpu::MemoryUse::DeviceLocal);
-  gpu::Buffer ao_blur, fxaa_input;
+  const uint64_t tiles = tileCount(width, height);
+  gpu::Buffer ao, ao_blur, fxaa_input, tile_flags, tile_list;
   try {
+    ao = gpu::createBuffer(context, bytes, gpu::MemoryUse::DeviceLocal);
     ao_blur = gpu::createBuffer(context, bytes, gpu::MemoryUse::DeviceLocal);
     fxaa_input = gpu::createBuffer(context, bytes, gpu::MemoryUse::DeviceLocal);
+    tile_flags = gpu::createBuffer(context, tiles * sizeof(uint32_t), gpu::MemoryUse::DeviceLocal);
+    tile_list = gpu::createBuffer(context, sizeof(shader::FibletListHeader) + tiles * sizeof(uint32_t),
+                                  gpu::MemoryUse::DeviceLocal, VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
   } catch (...) {
-    gpu::destroyBuffer(context, ao_blur);
-    gpu::destroyBuffer(context, ao);
+    for (gpu::Buffer* b : {&tile_list, &tile_flags, &fxaa_input, &ao_blur, &ao}) gpu::destroyBuffer(context, *b);
     throw;
   }
-  gpu::destroyBuffer(context, pass.ao);
-  gpu::destroyBuffer(context, pass.ao_blur);
-  gpu::destroyBuffer(context, pass.fxaa_input);
+  for (gpu::Buffer* b : {&pass.ao, &pass.ao_blur, &pass.fxaa_input, &pass.tile_flags, &pass.tile_list})
+    gpu::destroyBuffer(context, *b);
   pass.ao = ao;
   pass.ao_blur = ao_blur;
   pass.fxaa_input = fxaa_input;
+  pass.tile_flags = tile_flags;
+  pass.tile_list = tile_list;
   pass.width = width;
   pass.height = height;
 }
 
 bool inRange(float v, float lo, float hi) { return v >= lo && v <= hi; }  // false for NaN
 
+// One workgroup per covered tile: the list's own indirect command.
+template <typename Push>
+void dispatchTiles(VkCommandBuffer cmd, const gpu::ComputePipeline& pipeline, const Push& push,
+                   const gpu::Buffer& tile_list) {
+  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.pipeline);
+  vkCmdPushConstants(cmd, pipeline.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
+  vkCmdDispatchIndirect(cmd, tile_list.buffer, 0);
+}
+
+// Fills the output with the background, lists the covered tiles and makes
+// the list's dispatch ready for the tile passes.
+void recordTiles(VkCommandBuffer cmd, const ShadePass& pass,
+                 const GpuFrameTargets& frame, const gpu::Buffer& output, uint32_t background) {
+  const uint64_t tiles = tileCount(frame.width, frame.height);
+  vkCmdFillBuffer(cmd, pass.tile_flags.buffer, 0, tiles * sizeof(uint32_t), 0);
+  vkCmdFillBuffer(cmd, pass.tile_list.buffer, 0, sizeof(shader::FibletListHeader), 0);
+  vkCmdFillBuffer(cmd, output.buffer, 0, VkDeviceSize(frame.width) * frame.height * sizeof(uint32_t), background);
+  // The fills before the passes, and before the tile passes' indirect
+  // reads of the list's header.
+  gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                     VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
+                     VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT |
+                         VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
+  shader::TileClassifyPush classify{};
+  classify.gbuffer = frame.gbuffer.address;
+  classify.flags = pass.tile_flags.address;
+  classify.tiles = pass.tile_list.address;
+  classify.width = frame.width;
+  classify.height = frame.height;
+  gpu::recordDispatch(cmd, pass.tile_classify, classify, pixelGroupsX(frame), pixelGroupsY(frame));
+  gpu::computeToComputeBarrier(cmd);
+  shader::FibletListFinalizePush finalize{};
+  finalize.list = pass.tile_list.address;
+  finalize.items_per_group = 1;
+  finalize.max_groups_x = pass.max_groups_x;
+  gpu::recordDispatch(cmd, pass.tile_finalize, finalize, 1);
+  gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                     VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                     VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
+}
+
 }  // namespace
 
 ShadePass createShadePass(const gpu::VulkanContext& context, uint32_t width, uint32_t height) {
   ShadePass pass;
   try {
+    pass.tile_classify = gpu::createComputePipeline(context, "tile_classify.comp", sizeof(shader::TileClassifyPush));
+    pass.tile_finalize =
+        gpu::createComputePipeline(context, "fiblet_list_finalize.comp", sizeof(shader::FibletListFinalizePush));
     pass.ssao = gpu::createComputePipeline(context, "ssao.comp", sizeof(shader::SsaoPush));
     pass.ssao_blur = gpu::createComputePipeline(context, "ssao_blur.comp", sizeof(shader::SsaoBlurPush));
     pass.shade = gpu::createComputePipeline(context, "shade.comp", sizeof(shader::ShadePush));
@@ -81,6 +136,7 @@ ShadePass createShadePass(const gpu::VulkanContext& context, uint32_t width, uin
     const std::vector<uint32_t> tables = allColormapTables();
     pass.colormaps = gpu::createBuffer(context, tables.size() * sizeof(uint32_t), gpu::MemoryUse::DeviceLocal);
     gpu::uploadToBuffer(context, pass.colormaps, tables.data(), tables.size() * sizeof(uint32_t));
+    pass.max_groups_x = context.limits().maxComputeWorkGroupCount[0];
     createScratch(context, pass, width, height);
   } catch (...) {
     destroyShadePass(context, pass);
@@ -91,6 +147,8 @@ ShadePass createShadePass(const gpu::VulkanContext& context, uint32_t width, uin
 
 void destroyShadePass(const gpu::VulkanContext& context, ShadePass& pass) {
   gpu::destroyBuffer(context, pass.colormaps);
+  gpu::destroyBuffer(context, pass.tile_list);
+  gpu::destroyBuffer(context, pass.tile_flags);
   gpu::destroyBuffer(context, pass.fxaa_input);
   gpu::destroyBuffer(context, pass.ao_blur);
   gpu::destroyBuffer(context, pass.ao);
@@ -98,6 +156,8 @@ void destroyShadePass(const gpu::VulkanContext& context, ShadePass& pass) {
   gpu::destroyComputePipeline(context, pass.shade);
   gpu::destroyComputePipeline(context, pass.ssao_blur);
   gpu::destroyComputePipeline(context, pass.ssao);
+  gpu::destroyComputePipeline(context, pass.tile_finalize);
+  gpu::destroyComputePipeline(context, pass.tile_classify);
   pass.width = pass.height = 0;
 }
 
@@ -152,8 +212,11 @@ void recordShade(VkCommandBuffer cmd, const ShadePass& pass, const GpuFrameTarge
   if (frame.width != pass.width || frame.height != pass.height)
     throw Error("render: shading pass is " + std::to_string(pass.width) + " x " + std::to_string(pass.height) +
                 " px, the frame " + std::to_string(frame.width) + " x " + std::to_string(frame.height));
-  const uint32_t groups_x = pixelGroupsX(frame), groups_y = pixelGroupsY(frame);
   const bool ssao = settings.ssao && settings.ssao_radius_px > 0.0f && settings.ssao_strength > 0.0f;
+  const gpu::Buffer& output = settings.fxaa ? pass.fxaa_input : frame.color;
+  begin(cmd, timer, "tiles");
+  recordTiles(cmd, pass, frame, output, packRgba8(settings.background));
+  end(cmd, timer);
 
   if (ssao) {
     shader::SsaoPush push{};
@@ -167,8 +230,9 @@ void recordShade(VkCommandBuffer cmd, const ShadePass& pass, const GpuFrameTarge
     push.range_mm = settings.ssao_range_mm;
     push.strength = settings.ssao_strength;
     push.scales = uint32_t(settings.ao_scales);
+    push.tiles = pass.tile_list.address;
     begin(cmd, timer, "ssao");
-    gpu::recordDispatch(cmd, pass.ssao, push, groups_x, groups_y);
+    dispatchTiles(cmd, pass.ssao, push, pass.tile_list);
     end(cmd, timer);
     gpu::computeToComputeBarrier(cmd);
 
@@ -178,18 +242,19 @@ void recordShade(VkCommandBuffer cmd, const ShadePass& pass, const GpuFrameTarge
     blur.width = frame.width;
     blur.height = frame.height;
     blur.depth_tolerance_mm = kSsaoBlurDepthToleranceMm;
+    blur.tiles = pass.tile_list.address;
     begin(cmd, timer, "ssao blur");
     blur.ao_in = pass.ao.address;
     blur.ao_out = pass.ao_blur.address;
     blur.step_x = 1;
     blur.step_y = 0;
-    gpu::recordDispatch(cmd, pass.ssao_blur, blur, groups_x, groups_y);
+    dispatchTiles(cmd, pass.ssao_blur, blur, pass.tile_list);
     gpu::computeToComputeBarrier(cmd);
     blur.ao_in = pass.ao_blur.address;
     blur.ao_out = pass.ao.address;
     blur.step_x = 0;
     blur.step_y = 1;
-    gpu::recordDispatch(cmd, pass.ssao_blur, blur, groups_x, groups_y);
+    dispatchTiles(cmd, pass.ssao_blur, blur, pass.tile_list);
     end(cmd, timer);
     gpu::computeToComputeBarrier(cmd);
   }
@@ -198,7 +263,8 @@ void recordShade(VkCommandBuffer cmd, const ShadePass& pass, const GpuFrameTarge
   push.camera = frame.camera.address;
   push.gbuffer = frame.gbuffer.address;
   push.ao = ssao ? pass.ao.address : 0;
-  push.color = settings.fxaa ? pass.fxaa_input.address : frame.color.address;
+  push.color = output.address;
+  push.tiles = pass.tile_list.address;
   push.colormap = pass.colormaps.address + VkDeviceAddress(settings.colormap) * kColormapEntries * sizeof(uint32_t);
   push.fiber_scalars = fibers.fiber_scalars;
   push.selection_bits = fibers.selection_bits;
@@ -214,9 +280,7 @@ void recordShade(VkCommandBuffer cmd, const ShadePass& pass, const GpuFrameTarge
   }
   push.lighting = settings.lighting == Lighting::IlluminatedLines ? shader::kShadeLightingIlluminated
                                                                   : shader::kShadeLightingNone;
-  push.solid_r = settings.solid_color[0];
-  push.solid_g = settings.solid_color[1];
-  push.solid_b = settings.solid_color[2];
+  push.solid = packRgba8(settings.solid_color);
   push.background = packRgba8(settings.background);
   push.ambient = settings.light_ambient;
   push.diffuse = settings.light_diffuse;
@@ -227,7 +291,7 @@ void recordShade(VkCommandBuffer cmd, const ShadePass& pass, const GpuFrameTarge
   push.highlight = packRgba8(settings.highlight_color);
   push.dim_unselected = settings.dim_unselected;
   begin(cmd, timer, "shade");
-  gpu::recordDispatch(cmd, pass.shade, push, groups_x, groups_y);
+  dispatchTiles(cmd, pass.shade, push, pass.tile_list);
   end(cmd, timer);
 
   if (settings.fxaa) {

@@ -1,6 +1,8 @@
 // The shading passes shared by every pipeline (DESIGN.md section 6,
 // "Shading"): G-buffer + camera block -> the RGBA8 image of the frame
 // targets, with optional screen-space ambient occlusion.
+//   tiles      shaders/tile_classify.comp  the 8 x 8 tiles with a covered pixel;
+//                                          the passes below run on those only
 //   ssao       shaders/ssao.comp       occlusion factor per pixel (scratch buffer)
 //   ssao blur  shaders/ssao_blur.comp  depth-aware blur, x then y
 //   shade      shaders/shade.comp      colour x lighting x occlusion -> RGBA8
@@ -22,6 +24,8 @@
 namespace fibscope {
 
 struct ShadePass {
+  gpu::ComputePipeline tile_classify;  // tile_classify.comp
+  gpu::ComputePipeline tile_finalize;  // fiblet_list_finalize.comp, on the tile list
   gpu::ComputePipeline ssao;       // ssao.comp
   gpu::ComputePipeline ssao_blur;  // ssao_blur.comp
   gpu::ComputePipeline shade;      // shade.comp
@@ -32,9 +36,13 @@ struct ShadePass {
   // With FXAA, shade writes here (RGBA8 per pixel) and fxaa reads it into
   // the frame's colour buffer.
   gpu::Buffer fxaa_input;
+  // A flag per tile, and the covered tiles (shared/fiblet_list.h layout:
+  // the indirect dispatch of the tile passes, then the tile indices).
+  gpu::Buffer tile_flags, tile_list;
   // Every colormap's table (colormap.h: allColormapTables), uploaded once.
   gpu::Buffer colormaps;
   uint32_t width = 0, height = 0;
+  uint32_t max_groups_x = 0;  // maxComputeWorkGroupCount[0]: the tile list's grid
 };
 
 // The per-fiber inputs of shading (GpuScene::fiber_scalars and
@@ -64,11 +72,12 @@ void resizeShadePass(const gpu::VulkanContext& context, ShadePass& pass, uint32_
 void validateShadeSettings(const RenderSettings& settings);
 
 // Records the shading of `frame` (the camera block and the G-buffer must be
-// written and made visible to compute reads before): the SSAO passes when
+// written and made visible to compute reads before): the colour filled with
+// the background, the covered tiles listed ("tiles"), the SSAO passes when
 // settings.ssao (settings.ao_scales scales in the one "ssao" pass), then
 // shade, then fxaa when settings.fxaa, with their own barriers between them
-// and a timestamp pair per pass on `timer` when it is not null ("ssao",
-// "ssao blur", "shade", "fxaa"). The frame must have the pass's size.
+// and a timestamp pair per pass on `timer` when it is not null ("tiles",
+// "ssao", "ssao blur", "shade", "fxaa"). The frame must have the pass's size.
 // Throws Error for invalid settings or a size mismatch (nothing recorded
 // then).
 void recordShade(VkCommandBuffer cmd, const ShadePass& pass, const GpuFrameTargets& frame,
