@@ -500,6 +500,64 @@ TEST_F(GpuShade, ssaoRotationPatternIsAveragedAwayWhereTheDepthIsEven) {
   EXPECT_EQ(pixel(with_ao, 28, 16), pixel(plain, 28, 16));
 }
 
+TEST_F(GpuShade, tileListHoldsExactlyTheTilesWithACoveredPixel) {
+  // A frame of partial tiles (45 x 27: 6 x 4 tiles, the last column 5 px
+  // wide, the last row 3 px high), covered pixels in the corner tiles, in
+  // the partial ones and scattered; the listed tiles must be exactly the
+  // brute-force set, each once, and every pixel outside them the
+  // background (shade writes the listed tiles only).
+  constexpr uint32_t kW = 45, kH = 27, kTilesX = 6, kTilesY = 4;
+  Camera cam = camera();
+  cam.width = kW;
+  cam.height = kH;
+  std::vector<shader::GBufferTexel> gbuffer(kW * kH, {1.0f, shader::kNoFiberId, 0, 0});
+  const uint32_t covered[][2] = {{0, 0}, {44, 26}, {40, 3}, {7, 7}, {8, 8}, {9, 8}, {20, 26}, {44, 0}, {31, 13}};
+  std::set<uint32_t> expected;
+  for (const auto& c : covered) {
+    gbuffer[c[1] * kW + c[0]] = {clipDepth(cam, 100.0), 3, 0, packTangent({0, 1, 0})};
+    expected.insert(c[1] / 8 * kTilesX + c[0] / 8);
+  }
+  RenderSettings s;
+  s.background = {0.2f, 0.4f, 0.6f};
+  GpuFrameTargets frame = createFrameTargets(context(), kW, kH);
+  ShadePass pass{};
+  std::vector<uint8_t> rgba;
+  std::vector<uint32_t> list;
+  try {
+    pass = createShadePass(context(), kW, kH);
+    const shader::CameraBlock block = makeCameraBlock(cam, 1.0f);
+    gpu::uploadToBuffer(context(), frame.camera, &block, sizeof(block));
+    gpu::uploadToBuffer(context(), frame.gbuffer, gbuffer.data(), gbuffer.size() * sizeof(gbuffer[0]));
+    gpu::submitOnce(context(), [&](VkCommandBuffer cmd) { recordShade(cmd, pass, frame, s, nullptr); });
+    rgba = downloadColor(context(), frame);
+    list.resize(4 + kTilesX * kTilesY);
+    gpu::downloadFromBuffer(context(), pass.tile_list, list.data(), list.size() * sizeof(uint32_t));
+  } catch (...) {
+    destroyShadePass(context(), pass);
+    destroyFrameTargets(context(), frame);
+    throw;
+  }
+  destroyShadePass(context(), pass);
+  destroyFrameTargets(context(), frame);
+  const uint32_t count = list[3];  // FibletListHeader: dispatch x, y, z, count
+  ASSERT_EQ(count, expected.size());
+  EXPECT_EQ(list[0] * list[1] * list[2], count) << "the indirect dispatch is one workgroup per tile";
+  const std::multiset<uint32_t> listed(list.begin() + 4, list.begin() + 4 + count);
+  EXPECT_EQ(std::set<uint32_t>(listed.begin(), listed.end()), expected);
+  EXPECT_EQ(listed.size(), std::set<uint32_t>(listed.begin(), listed.end()).size()) << "a tile listed twice";
+  const uint8_t bg[3] = {uint8_t(0.2f * 255 + 0.5f), uint8_t(0.4f * 255 + 0.5f), uint8_t(0.6f * 255 + 0.5f)};
+  size_t drawn = 0;
+  for (uint32_t y = 0; y < kH; ++y)
+    for (uint32_t x = 0; x < kW; ++x) {
+      const uint8_t* p = &rgba[4 * (y * kW + x)];
+      const bool is_background = p[0] == bg[0] && p[1] == bg[1] && p[2] == bg[2] && p[3] == 255;
+      const bool fiber = gbuffer[y * kW + x].fiber != shader::kNoFiberId;
+      EXPECT_EQ(is_background, !fiber) << "pixel " << x << ", " << y;
+      drawn += fiber;
+    }
+  EXPECT_EQ(drawn, std::size(covered));
+}
+
 TEST_F(GpuShade, settingsOutOfRangeAreRejected) {
   RenderSettings s;
   s.ssao_strength = 1.5f;
