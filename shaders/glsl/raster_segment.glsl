@@ -22,6 +22,16 @@ bool segmentOutsideFrustum(vec4 a, vec4 b) {
          (a.y > a.w && b.y > b.w) || (a.z < 0.0 && b.z < 0.0) || (a.z > a.w && b.z > b.w);
 }
 
+// Whether the centre of pixel (px, py) lies within `radius` of the segment
+// (step 5): rasterPixel's test alone.
+bool pixelCovered(int px, int py, vec3 a, vec3 ab, float length2, float radius2) {
+  const vec2 c = vec2(float(px) + 0.5, float(py) + 0.5);
+  float t = 0.0;
+  if (length2 > 0.0) t = clamp(dot(c - a.xy, ab.xy) / length2, 0.0, 1.0);
+  const vec2 e = c - (a.xy + t * ab.xy);
+  return dot(e, e) <= radius2;
+}
+
 // Covers pixel (px, py) with the segment a -> b (window x, y and depth)
 // when its centre lies within `radius` of it (step 5), nearest key wins
 // (steps 6, 7).
@@ -73,10 +83,23 @@ void rasterClipSegment(VisibilityRef vis, CameraBlock cam, vec4 c0, vec4 c1, uin
   // walk's.
   if (max(abs(ab.x), abs(ab.y)) + 2.0 * radius < 2.0) {
     const int x0 = int(ceil(min(a.x, b.x) - radius - 0.5)), y0 = int(ceil(min(a.y, b.y) - radius - 0.5));
+    // First which of the four pass the per-pixel distance test (arithmetic
+    // only), then one memory access per covered pixel, in a loop whose trip
+    // count is the lane's number of covered pixels (one or two for a line
+    // of width 1): on a CPU device every memory access of the program costs
+    // its per-lane loop whether or not a lane takes it, and four unrolled
+    // tests cost four.
+    uint covered = 0u;
     for (int j = 0; j < 4; ++j) {
       const int px = x0 + (j & 1), py = y0 + (j >> 1);
-      if (px >= 0 && py >= 0 && px < int(width) && py < int(height))
-        rasterPixel(vis, width, px, py, a, ab, length2, radius2, payload);
+      if (px >= 0 && py >= 0 && px < int(width) && py < int(height) &&
+          pixelCovered(px, py, a, ab, length2, radius2))
+        covered |= 1u << j;
+    }
+    while (covered != 0u) {
+      const int j = findLSB(covered);
+      covered &= covered - 1u;
+      rasterPixel(vis, width, x0 + (j & 1), y0 + (j >> 1), a, ab, length2, radius2, payload);
     }
     return;
   }
