@@ -5,7 +5,9 @@
 // fiber base, the tangent from the rasters'
 // tangent cache when there is one, else by decoding the fiblet from its
 // start up to the segment (sequential composition, at most 60 steps; only
-// covered pixels pay for it).
+// covered pixels pay for it). Which of the two is a specialisation constant,
+// not a branch on the push constant: a CPU device's SIMD lanes run both
+// sides of every branch, and the decode would cost every pixel.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_buffer_reference : require
@@ -17,6 +19,8 @@
 #include "glsl/tangent.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;  // kPixelGroupSize
+// True: pc.tangents is the rasters' tangent cache; false: decode.
+layout(constant_id = 0) const bool kTangentCache = true;
 
 layout(push_constant, std430) uniform Push { FibletResolvePush pc; };
 
@@ -49,7 +53,7 @@ void main() {
     const SceneDataset owner = scene.datasets[entry];
     const FibletDataset ds = DatasetRef(owner.block).ds;
     const uint fiblet = global - owner.fiblet_base;
-    if (pc.tangents != 0ul) {
+    if (kTangentCache) {
       // The rasters left every drawn segment's tangent in the cache
       // (indexed by the global fiblet).
       texel.tangent = UintsRef(pc.tangents).values[global * 64u + segment];

@@ -76,7 +76,13 @@ FibletPasses createFibletPasses(const gpu::VulkanContext& context, uint32_t rast
           context, passes.raster_subgroup_scan ? "fiblet_raster_subgroup.comp" : "fiblet_raster.comp",
           sizeof(shader::FibletRasterPush), specialization);
     }
-    passes.resolve = gpu::createComputePipeline(context, "fiblet_resolve.comp", sizeof(shader::FibletResolvePush));
+    // Two pipelines, not a branch on the push constant: a CPU device runs
+    // both sides of a branch, and the decode is most of the shader.
+    const uint32_t cache[] = {1u}, decode[] = {0u};
+    passes.resolve =
+        gpu::createComputePipeline(context, "fiblet_resolve.comp", sizeof(shader::FibletResolvePush), cache);
+    passes.resolve_decode =
+        gpu::createComputePipeline(context, "fiblet_resolve.comp", sizeof(shader::FibletResolvePush), decode);
   } catch (...) {
     destroyFibletPasses(context, passes);
     throw;
@@ -85,6 +91,7 @@ FibletPasses createFibletPasses(const gpu::VulkanContext& context, uint32_t rast
 }
 
 void destroyFibletPasses(const gpu::VulkanContext& context, FibletPasses& passes) {
+  gpu::destroyComputePipeline(context, passes.resolve_decode);
   gpu::destroyComputePipeline(context, passes.resolve);
   gpu::destroyComputePipeline(context, passes.raster);
 }
@@ -136,7 +143,8 @@ void recordFibletResolve(VkCommandBuffer cmd, const FibletPasses& passes, VkDevi
   push.tangents = frame.tangents.address;
   push.width = frame.width;
   push.height = frame.height;
-  gpu::recordDispatch(cmd, passes.resolve, push, pixelGroupsX(frame), pixelGroupsY(frame));
+  gpu::recordDispatch(cmd, push.tangents != 0 ? passes.resolve : passes.resolve_decode, push, pixelGroupsX(frame),
+                      pixelGroupsY(frame));
 }
 
 }  // namespace fibscope

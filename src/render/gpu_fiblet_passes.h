@@ -19,7 +19,8 @@ namespace fibscope {
 
 struct FibletPasses {
   gpu::ComputePipeline raster;   // fiblet_raster.comp
-  gpu::ComputePipeline resolve;  // fiblet_resolve.comp
+  gpu::ComputePipeline resolve;         // fiblet_resolve.comp, tangents from the rasters' cache
+  gpu::ComputePipeline resolve_decode;  // the same decoding the tangents (frames without a cache)
   uint32_t raster_lanes = 0;     // invocations per fiblet in the raster
   uint32_t raster_fiblets_per_group = 1;  // fiblets per raster workgroup
   bool raster_subgroup_scan = false;      // fiblet_raster_subgroup.comp (else fiblet_raster.comp)
