@@ -25,7 +25,7 @@ void main() {
   PyramidRef pyramid = PyramidRef(pc.pyramid);
   float depth;
   if (pc.level == 0u) {
-    const uint64_t key = VisibilityRef(pc.visibility).keys[p.y * w + p.x];
+    const uint64_t key = VisibilityRef(pc.visibility).keys[visibilityIndex(p.x, p.y, w)];
     depth = key == 0xFFFFFFFFFFFFFFFFul ? 1.0 : visibilityDepth(key);
   } else {
     const uint pw = pyramidLevelSize(pc.width, pc.level - 1u), ph = pyramidLevelSize(pc.height, pc.level - 1u);

@@ -20,7 +20,7 @@ void main() {
   const uvec2 p = gl_GlobalInvocationID.xy;
   if (p.x >= pc.width || p.y >= pc.height) return;
   const uint index = p.y * pc.width + p.x;
-  const uint64_t key = VisibilityRef(pc.visibility).keys[index];
+  const uint64_t key = VisibilityRef(pc.visibility).keys[visibilityIndex(p.x, p.y, pc.width)];
   GBufferTexel texel;
   texel.depth = 1.0;
   texel.fiber = kNoFiberId;

@@ -49,7 +49,7 @@ void rasterPixel(VisibilityRef vis, uint width, int px, int py, vec3 a, vec3 ab,
   // fragments of a dense tractogram) the atomic is skipped. Keys only
   // decrease, so a stale load can only let an atomic through, never skip a
   // needed one.
-  const uint index = uint(py) * width + uint(px);
+  const uint index = visibilityIndex(uint(px), uint(py), width);
   const uint64_t key = visibilityKey(depth, payload);
   if (key < vis.keys[index]) atomicMin(vis.keys[index], key);
 }

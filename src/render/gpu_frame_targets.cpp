@@ -5,6 +5,7 @@
 
 #include "core/error.h"
 #include "render/gpu_dataset.h"
+#include "shared/render_config.h"
 
 namespace fibscope {
 
@@ -21,7 +22,8 @@ GpuFrameTargets createFrameTargets(const gpu::VulkanContext& context, uint32_t w
   t.height = height;
   try {
     t.camera = gpu::createBuffer(context, sizeof(shader::CameraBlock), gpu::MemoryUse::DeviceLocal);
-    t.visibility = gpu::createBuffer(context, t.pixels() * sizeof(uint64_t), gpu::MemoryUse::DeviceLocal);
+    t.visibility = gpu::createBuffer(context, uint64_t(shader::visibilityKeyCount(width, height)) * sizeof(uint64_t),
+                                     gpu::MemoryUse::DeviceLocal);
     t.gbuffer = gpu::createBuffer(context, t.pixels() * sizeof(shader::GBufferTexel), gpu::MemoryUse::DeviceLocal);
     t.color = gpu::createBuffer(context, t.pixels() * sizeof(uint32_t), gpu::MemoryUse::DeviceLocal);
   } catch (...) {
@@ -71,8 +73,12 @@ std::vector<shader::GBufferTexel> downloadGBuffer(const gpu::VulkanContext& cont
 }
 
 std::vector<uint64_t> downloadVisibility(const gpu::VulkanContext& context, const GpuFrameTargets& targets) {
+  std::vector<uint64_t> blocks(shader::visibilityKeyCount(targets.width, targets.height));
+  gpu::downloadFromBuffer(context, targets.visibility, blocks.data(), blocks.size() * sizeof(uint64_t));
   std::vector<uint64_t> keys(targets.pixels());
-  gpu::downloadFromBuffer(context, targets.visibility, keys.data(), keys.size() * sizeof(uint64_t));
+  for (uint32_t y = 0; y < targets.height; ++y)
+    for (uint32_t x = 0; x < targets.width; ++x)
+      keys[size_t(y) * targets.width + x] = blocks[shader::visibilityIndex(x, y, targets.width)];
   return keys;
 }
 

@@ -18,7 +18,7 @@ namespace fibscope {
 struct GpuFrameTargets {
   uint32_t width = 0, height = 0;
   gpu::Buffer camera;      // one CameraBlock, updated in the command buffer each frame
-  gpu::Buffer visibility;  // uint64_t key per pixel (shared/render_config.h)
+  gpu::Buffer visibility;  // uint64_t key per pixel, in 4 x 2 blocks (shared/render_config.h: visibilityIndex)
   gpu::Buffer gbuffer;     // GBufferTexel per pixel (shared/gbuffer.h)
   gpu::Buffer color;       // RGBA8 per pixel as one uint (R in the low byte), top row first
   // Optional (empty: address 0): the packed tangent of every segment the
@@ -46,6 +46,7 @@ void prepareTangentCache(const gpu::VulkanContext& context, GpuFrameTargets& tar
 // Read-backs for tests and PNG output (wait for the queue).
 std::vector<uint8_t> downloadColor(const gpu::VulkanContext& context, const GpuFrameTargets& targets);
 std::vector<shader::GBufferTexel> downloadGBuffer(const gpu::VulkanContext& context, const GpuFrameTargets& targets);
+// The keys row by row (the buffer holds them in 4 x 2 blocks: visibilityIndex).
 std::vector<uint64_t> downloadVisibility(const gpu::VulkanContext& context, const GpuFrameTargets& targets);
 
 }  // namespace fibscope

@@ -20,6 +20,7 @@
 #include "render/png_writer.h"
 #include "render/reference_raster.h"
 #include "shared/camera.h"
+#include "shared/render_config.h"
 #include "test_support.h"
 
 namespace fibscope {
@@ -606,6 +607,28 @@ TEST(ImageCompare, DistanceTransformEqualsBruteForce) {
               best = std::min(best, dx * dx + dy * dy);
             }
         ASSERT_EQ(got[size_t(y) * w + x], best) << w << "x" << h << " at " << x << "," << y;
+      }
+  }
+}
+
+}  // namespace
+}  // namespace fibscope
+
+namespace fibscope {
+namespace {
+
+TEST(VisibilityLayout, FourByTwoBlocksMapEveryPixelToItsOwnKeyInsideThePaddedBuffer) {
+  for (const auto& [w, h] : {std::pair<uint32_t, uint32_t>{1, 1}, {4, 2}, {5, 3}, {75, 41}, {1920, 1080}}) {
+    const uint32_t keys = shader::visibilityKeyCount(w, h);
+    EXPECT_EQ(keys, ((w + 3) / 4 * 4) * ((h + 1) / 2 * 2)) << w << " x " << h;
+    std::vector<uint8_t> used(keys, 0);
+    for (uint32_t y = 0; y < h; ++y)
+      for (uint32_t x = 0; x < w; ++x) {
+        const uint32_t i = shader::visibilityIndex(x, y, w);
+        ASSERT_LT(i, keys) << x << ", " << y << " of " << w << " x " << h;
+        ASSERT_EQ(used[i]++, 0) << "two pixels share key " << i;
+        // A block of 4 x 2 pixels is one 64-byte line (8 keys, aligned).
+        EXPECT_EQ(i / 8, shader::visibilityIndex(x & ~3u, y & ~1u, w) / 8);
       }
   }
 }
