@@ -115,7 +115,7 @@ Buffer createBuffer(const VulkanContext& context, VkDeviceSize size, MemoryUse u
   return buffer;
 }
 
-void* mapForDirectWrite(const VulkanContext& context, const Buffer& buffer) {
+void* mapForDirectAccess(const VulkanContext& context, const Buffer& buffer) {
   const VkPhysicalDeviceType type = context.info().type;
   if (type != VK_PHYSICAL_DEVICE_TYPE_CPU && type != VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU) return nullptr;
   constexpr VkMemoryPropertyFlags kNeeded = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
@@ -179,6 +179,21 @@ void downloadFromBuffer(const VulkanContext& context, const Buffer& buffer, void
       VK_CHECK(vkInvalidateMappedMemoryRanges(context.device(), 1, &range));
     }
     std::memcpy(data, static_cast<const char*>(buffer.mapped) + offset, bytes);
+    return;
+  }
+  if (void* direct = mapForDirectAccess(context, buffer)) {
+    try {
+      // A barrier's first scope is every command submitted before it.
+      submitOnce(context, [&](VkCommandBuffer cmd) {
+        memoryBarrier(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
+                      VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+      });
+    } catch (...) {
+      unmapBuffer(context, buffer);
+      throw;
+    }
+    std::memcpy(data, static_cast<const char*>(direct) + offset, bytes);
+    unmapBuffer(context, buffer);
     return;
   }
   Buffer staging = createBuffer(context, bytes, MemoryUse::Readback);

@@ -41,14 +41,15 @@ VkDeviceMemory allocateMemory(const VulkanContext& context, const VkMemoryRequir
 // arguments). Throws Error when size exceeds the device's largest
 // allocation or memory runs out.
 Buffer createBuffer(const VulkanContext& context, VkDeviceSize size, MemoryUse use, VkBufferUsageFlags extra_usage = 0);
-// For filling a DeviceLocal buffer the GPU has not used yet without a
-// staging copy: where the device shares the host's memory (a CPU device
-// such as lavapipe, or an integrated GPU) and the buffer's memory is
-// host-visible and coherent, maps it and returns the pointer (unmapBuffer
-// when done; writes need no flush and are visible to later submissions);
-// nullptr otherwise. Discrete GPUs keep the DMA copy: writing device
-// memory over the bus from the CPU is slower than the copy engine.
-void* mapForDirectWrite(const VulkanContext& context, const Buffer& buffer);
+// For filling a DeviceLocal buffer the GPU has not used yet, or reading
+// one after the GPU is done with it, without a staging copy: where the
+// device shares the host's memory (a CPU device such as lavapipe, or an
+// integrated GPU) and the buffer's memory is host-visible and coherent,
+// maps it and returns the pointer (unmapBuffer when done; writes need no
+// flush and are visible to later submissions); nullptr otherwise. Discrete
+// GPUs keep the DMA copy: reaching device memory over the bus from the CPU
+// is slower than the copy engine.
+void* mapForDirectAccess(const VulkanContext& context, const Buffer& buffer);
 void unmapBuffer(const VulkanContext& context, const Buffer& buffer);
 
 // Destroys and resets `buffer`; a default Buffer is a no-op.
@@ -56,8 +57,11 @@ void destroyBuffer(const VulkanContext& context, Buffer& buffer);
 
 // Copies bytes into / out of the buffer at `offset` (offset + bytes <=
 // size): by memcpy for mapped buffers, through a temporary staging buffer
-// and a one-shot copy for device-local ones. The GPU must not be using the
-// range (the staging copy waits for the queue to finish).
+// and a one-shot copy for device-local ones (a download from a device that
+// shares the host's memory maps the buffer instead, after a barrier that
+// makes every earlier submission's writes visible to the host). The GPU
+// must not be using the range (the staging copy waits for the queue to
+// finish).
 void uploadToBuffer(const VulkanContext& context, const Buffer& buffer, const void* data, size_t bytes,
                     VkDeviceSize offset = 0);
 void downloadFromBuffer(const VulkanContext& context, const Buffer& buffer, void* data, size_t bytes,

@@ -46,7 +46,7 @@ void uploadChunked(const gpu::VulkanContext& context, const gpu::Buffer& staging
 void uploadRandomAccess(const gpu::VulkanContext& context, const std::function<const gpu::Buffer&()>& staging,
                         const gpu::Buffer& destination, uint64_t bytes, const ChunkSource& source, Progress* progress) {
   if (bytes == 0) return;
-  uint8_t* mapped = static_cast<uint8_t*>(gpu::mapForDirectWrite(context, destination));
+  uint8_t* mapped = static_cast<uint8_t*>(gpu::mapForDirectAccess(context, destination));
   if (!mapped) {
     uploadChunked(context, staging(), destination, bytes, source, progress);
     return;

@@ -30,7 +30,7 @@ void uploadChunked(const gpu::VulkanContext& context, const gpu::Buffer& staging
 
 // As uploadChunked, for a source that may be asked for any range, in any
 // order and from several threads at once (bytesOf is): where
-// gpu::mapForDirectWrite maps `destination` (CPU and integrated devices),
+// gpu::mapForDirectAccess maps `destination` (CPU and integrated devices),
 // the source writes straight into it, each 64 MiB spread over the hardware
 // threads (the first-touch page faults of the fresh memory too), with no
 // staging copy and no submission; otherwise uploadChunked through the
