@@ -84,7 +84,9 @@ TEST_F(GpuStagedUpload, inPlaceOnASharedMemoryDeviceSpreadOverThreadsWithoutStag
     next = offset + bytes;
   }
   EXPECT_EQ(next, n);
-  if (ThreadPool::hardwareThreads() > 1) EXPECT_GT(ranges.size(), 2u);
+  if (ThreadPool::hardwareThreads() > 1) {
+    EXPECT_GT(ranges.size(), 2u);
+  }
 }
 
 TEST_F(GpuStagedUpload, bufferThatCannotBeWrittenInPlaceGoesThroughStaging) {
