@@ -28,8 +28,7 @@ void main() {
   // No early return: the vote below needs every invocation of the subgroup.
   const bool covered = inside && GBufferRef(pc.gbuffer).texels[p.y * pc.width + p.x].fiber != kNoFiberId;
   if (subgroupAny(covered) && subgroupElect()) {
-    const uint tiles_x = (pc.width + kPixelGroupSize - 1u) / kPixelGroupSize;
-    const uint tile = gl_WorkGroupID.y * tiles_x + gl_WorkGroupID.x;
+    const uint tile = gl_WorkGroupID.y * pixelGroups(pc.width) + gl_WorkGroupID.x;
     if (atomicOr(FlagsRef(pc.flags).flags[tile], 1u) == 0u) {
       TileListRef list = TileListRef(pc.tiles);
       list.tiles[atomicAdd(list.header.count, 1u)] = tile;

@@ -17,7 +17,7 @@ bool tilePixel(uint64_t tiles, uint width, uint height, out uvec2 p) {
   TileListRef list = TileListRef(tiles);
   const uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
   if (group >= list.header.count) return false;
-  const uint tile = list.tiles[group], tiles_x = (width + kPixelGroupSize - 1u) / kPixelGroupSize;
+  const uint tile = list.tiles[group], tiles_x = pixelGroups(width);
   p = uvec2(tile % tiles_x, tile / tiles_x) * kPixelGroupSize + gl_LocalInvocationID.xy;
   return p.x < width && p.y < height;
 }

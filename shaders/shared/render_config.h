@@ -55,6 +55,10 @@ RENDER_CONST float kMaxLineWidthPx = 4.0f;
 // Marks an empty G-buffer texel (fiber field) and "no fiber" elsewhere.
 RENDER_CONST uint kNoFiberId = 0xFFFFFFFFu;
 
+// Tiles of kPixelGroupSize pixels covering `pixels` along one axis: the
+// workgroups of a per-pixel pass.
+SHADER_FN uint pixelGroups(uint pixels) { return (pixels + kPixelGroupSize - 1u) / kPixelGroupSize; }
+
 SHADER_FN uint64_t visibilityKey(float depth, uint64_t payload) {
   return (uint64_t(floatBitsToUint(depth)) << kKeyPayloadBits) | payload;
 }

@@ -244,8 +244,7 @@ void recordDepthPyramid(VkCommandBuffer cmd, const CullPasses& passes, const Gpu
     push.level = level;
     const uint32_t w = shader::pyramidLevelSize(frame.width, level);
     const uint32_t h = shader::pyramidLevelSize(frame.height, level);
-    gpu::recordDispatch(cmd, passes.pyramid, push, (w + shader::kPixelGroupSize - 1) / shader::kPixelGroupSize,
-                        (h + shader::kPixelGroupSize - 1) / shader::kPixelGroupSize);
+    gpu::recordDispatch(cmd, passes.pyramid, push, shader::pixelGroups(w), shader::pixelGroups(h));
   }
 }
 

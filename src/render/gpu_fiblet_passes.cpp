@@ -96,12 +96,8 @@ void destroyFibletPasses(const gpu::VulkanContext& context, FibletPasses& passes
   gpu::destroyComputePipeline(context, passes.raster);
 }
 
-uint32_t pixelGroupsX(const GpuFrameTargets& frame) {
-  return (frame.width + shader::kPixelGroupSize - 1) / shader::kPixelGroupSize;
-}
-uint32_t pixelGroupsY(const GpuFrameTargets& frame) {
-  return (frame.height + shader::kPixelGroupSize - 1) / shader::kPixelGroupSize;
-}
+uint32_t pixelGroupsX(const GpuFrameTargets& frame) { return shader::pixelGroups(frame.width); }
+uint32_t pixelGroupsY(const GpuFrameTargets& frame) { return shader::pixelGroups(frame.height); }
 
 void recordFibletRasterAll(VkCommandBuffer cmd, const gpu::VulkanContext& context, const FibletPasses& passes,
                            const GpuDataset& dataset, const GpuFrameTargets& frame, uint32_t fiblet_base) {

@@ -47,8 +47,7 @@ void end(VkCommandBuffer cmd, gpu::GpuTimer* timer) {
 }
 
 uint64_t tileCount(uint32_t width, uint32_t height) {
-  return uint64_t((width + shader::kPixelGroupSize - 1) / shader::kPixelGroupSize) *
-         ((height + shader::kPixelGroupSize - 1) / shader::kPixelGroupSize);
+  return uint64_t(shader::pixelGroups(width)) * shader::pixelGroups(height);
 }
 
 void createScratch(const gpu::VulkanContext& context, ShadePass& pass, uint32_t width, uint32_t height) {
@@ -202,8 +201,7 @@ void recordFxaa(VkCommandBuffer cmd, const ShadePass& pass, const gpu::Buffer& i
   push.edge_threshold = kFxaaEdgeThreshold;
   push.edge_threshold_min = kFxaaEdgeThresholdMin;
   push.subpix = kFxaaSubpix;
-  gpu::recordDispatch(cmd, pass.fxaa, push, (width + shader::kPixelGroupSize - 1) / shader::kPixelGroupSize,
-                      (height + shader::kPixelGroupSize - 1) / shader::kPixelGroupSize);
+  gpu::recordDispatch(cmd, pass.fxaa, push, shader::pixelGroups(width), shader::pixelGroups(height));
 }
 
 void recordShade(VkCommandBuffer cmd, const ShadePass& pass, const GpuFrameTargets& frame,

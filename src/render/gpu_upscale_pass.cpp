@@ -32,8 +32,7 @@ void recordUpscale(VkCommandBuffer cmd, const UpscalePass& pass, const gpu::Buff
   push.src_height = src_height;
   push.dst_width = dst_width;
   push.dst_height = dst_height;
-  gpu::recordDispatch(cmd, pass.pipeline, push, (dst_width + shader::kPixelGroupSize - 1) / shader::kPixelGroupSize,
-                      (dst_height + shader::kPixelGroupSize - 1) / shader::kPixelGroupSize);
+  gpu::recordDispatch(cmd, pass.pipeline, push, shader::pixelGroups(dst_width), shader::pixelGroups(dst_height));
 }
 
 }  // namespace fibscope
