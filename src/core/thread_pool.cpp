@@ -1,6 +1,7 @@
 #include "core/thread_pool.h"
 
 #include <algorithm>
+#include <exception>
 #include <utility>
 
 namespace fibscope {
@@ -45,6 +46,25 @@ void ThreadPool::run(unsigned worker) {
     }
     task(worker);  // an exception is stored in the task's future
   }
+}
+
+void runPieces(unsigned pieces, const std::function<void(unsigned)>& piece) {
+  std::vector<std::future<void>> others;
+  for (unsigned i = 1; i < pieces; ++i) others.push_back(std::async(std::launch::async, piece, i));
+  std::exception_ptr error;
+  try {
+    if (pieces > 0) piece(0);
+  } catch (...) {
+    error = std::current_exception();
+  }
+  for (auto& other : others) {
+    try {
+      other.get();
+    } catch (...) {
+      if (!error) error = std::current_exception();
+    }
+  }
+  if (error) std::rethrow_exception(error);
 }
 
 }  // namespace fibscope

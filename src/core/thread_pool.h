@@ -38,4 +38,11 @@ class ThreadPool {
   bool stopping_ = false;
 };
 
+// Runs piece(0) .. piece(pieces - 1) at once: piece 0 on the calling thread,
+// each other on a thread of its own, and returns when all are done; the
+// first exception of a piece reaches the caller. For a few large pieces of
+// one job (bands of an image, ranges of a copy), where a pool's queue buys
+// nothing.
+void runPieces(unsigned pieces, const std::function<void(unsigned)>& piece);
+
 }  // namespace fibscope

@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cstring>
-#include <future>
-#include <vector>
 
 #include "core/thread_pool.h"
 
@@ -53,19 +51,16 @@ void uploadRandomAccess(const gpu::VulkanContext& context, const std::function<c
   }
   constexpr uint64_t kRound = uint64_t(64) << 20;  // progress steps
   constexpr uint64_t kMinPiece = uint64_t(4) << 20;  // smaller is not worth a thread
-  const uint64_t threads = std::max(1u, ThreadPool::hardwareThreads());
   try {
     for (uint64_t round = 0; round < bytes; round += kRound) {
       const uint64_t round_bytes = std::min(kRound, bytes - round);
-      const uint64_t pieces = std::clamp<uint64_t>(round_bytes / kMinPiece, 1, threads);
+      const unsigned pieces =
+          unsigned(std::clamp<uint64_t>(round_bytes / kMinPiece, 1, ThreadPool::hardwareThreads()));
       const uint64_t piece = (round_bytes + pieces - 1) / pieces;
-      std::vector<std::future<void>> helpers;
-      for (uint64_t begin = round + piece; begin < round + round_bytes; begin += piece) {
-        const uint64_t n = std::min(piece, round + round_bytes - begin);
-        helpers.push_back(std::async(std::launch::async, [&source, mapped, begin, n] { source(mapped + begin, begin, n); }));
-      }
-      source(mapped + round, round, std::min(piece, round_bytes));
-      for (auto& helper : helpers) helper.get();
+      runPieces(pieces, [&](unsigned i) {
+        const uint64_t begin = round + i * piece;
+        if (begin < round + round_bytes) source(mapped + begin, begin, std::min(piece, round + round_bytes - begin));
+      });
       if (progress) progress->add(double(round_bytes));
     }
   } catch (...) {

@@ -6,9 +6,9 @@
 #include <cstring>
 #include <memory>
 #include <string>
-#include <thread>
 
 #include "core/error.h"
+#include "core/thread_pool.h"
 #include "core/output_file.h"
 
 namespace fibscope {
@@ -47,7 +47,7 @@ struct DeflatedBand {
 
 std::vector<DeflatedBand> deflateScanlines(uint32_t width, uint32_t height, const std::vector<uint8_t>& rgba) {
   const size_t row_bytes = size_t(width) * 4;
-  const unsigned bands = std::clamp<unsigned>(height / 64, 1, std::max(1u, std::thread::hardware_concurrency()));
+  const unsigned bands = std::clamp<unsigned>(height / 64, 1, ThreadPool::hardwareThreads());
   std::vector<DeflatedBand> out(bands);
   auto deflateBand = [&](unsigned b) {
     const uint32_t y0 = uint32_t(uint64_t(height) * b / bands), y1 = uint32_t(uint64_t(height) * (b + 1) / bands);
@@ -81,10 +81,7 @@ std::vector<DeflatedBand> deflateScanlines(uint32_t width, uint32_t height, cons
     band.adler = adler;
     band.raw_bytes = uLong(raw_size);
   };
-  std::vector<std::jthread> helpers;
-  for (unsigned b = 1; b < bands; ++b) helpers.emplace_back(deflateBand, b);
-  deflateBand(0);
-  helpers.clear();  // joins
+  runPieces(bands, deflateBand);
   return out;
 }
 
