@@ -221,16 +221,30 @@ class GpuShade : public test::GpuTest {
     std::vector<shader::GBufferTexel> gbuffer(kSize * kSize, {1.0f, shader::kNoFiberId, 0, 0});
     for (const Texel& t : texels)
       gbuffer[t.y * kSize + t.x] = {clipDepth(camera(), t.distance_mm), t.fiber, 0, packTangent(t.tangent)};
-    GpuFrameTargets frame = createFrameTargets(context(), kSize, kSize);
+    return shadeGBuffer(camera(), gbuffer, settings, fibers);
+  }
+
+  // Shades `gbuffer` (camera.width x camera.height texels) and returns
+  // RGBA8; with `tile_list`, also the shade pass's tile list as the words
+  // of its buffer (header, then one index per tile at most).
+  std::vector<uint8_t> shadeGBuffer(const Camera& cam, const std::vector<shader::GBufferTexel>& gbuffer,
+                                    const RenderSettings& settings, const ShadeFiberInputs& fibers = {},
+                                    std::vector<uint32_t>* tile_list = nullptr) {
+    const uint32_t w = cam.width, h = cam.height;
+    GpuFrameTargets frame = createFrameTargets(context(), w, h);
     ShadePass pass{};
     std::vector<uint8_t> rgba;
     try {
-      pass = createShadePass(context(), kSize, kSize);
-      const shader::CameraBlock block = makeCameraBlock(camera(), 1.0f);
+      pass = createShadePass(context(), w, h);
+      const shader::CameraBlock block = makeCameraBlock(cam, 1.0f);
       gpu::uploadToBuffer(context(), frame.camera, &block, sizeof(block));
       gpu::uploadToBuffer(context(), frame.gbuffer, gbuffer.data(), gbuffer.size() * sizeof(gbuffer[0]));
       gpu::submitOnce(context(), [&](VkCommandBuffer cmd) { recordShade(cmd, pass, frame, settings, nullptr, fibers); });
       rgba = downloadColor(context(), frame);
+      if (tile_list) {
+        tile_list->resize(pass.tile_list.size / sizeof(uint32_t));
+        gpu::downloadFromBuffer(context(), pass.tile_list, tile_list->data(), pass.tile_list.size);
+      }
     } catch (...) {
       destroyShadePass(context(), pass);
       destroyFrameTargets(context(), frame);
@@ -519,26 +533,9 @@ TEST_F(GpuShade, tileListHoldsExactlyTheTilesWithACoveredPixel) {
   }
   RenderSettings s;
   s.background = {0.2f, 0.4f, 0.6f};
-  GpuFrameTargets frame = createFrameTargets(context(), kW, kH);
-  ShadePass pass{};
-  std::vector<uint8_t> rgba;
   std::vector<uint32_t> list;
-  try {
-    pass = createShadePass(context(), kW, kH);
-    const shader::CameraBlock block = makeCameraBlock(cam, 1.0f);
-    gpu::uploadToBuffer(context(), frame.camera, &block, sizeof(block));
-    gpu::uploadToBuffer(context(), frame.gbuffer, gbuffer.data(), gbuffer.size() * sizeof(gbuffer[0]));
-    gpu::submitOnce(context(), [&](VkCommandBuffer cmd) { recordShade(cmd, pass, frame, s, nullptr); });
-    rgba = downloadColor(context(), frame);
-    list.resize(4 + kTilesX * kTilesY);
-    gpu::downloadFromBuffer(context(), pass.tile_list, list.data(), list.size() * sizeof(uint32_t));
-  } catch (...) {
-    destroyShadePass(context(), pass);
-    destroyFrameTargets(context(), frame);
-    throw;
-  }
-  destroyShadePass(context(), pass);
-  destroyFrameTargets(context(), frame);
+  const std::vector<uint8_t> rgba = shadeGBuffer(cam, gbuffer, s, {}, &list);
+  ASSERT_EQ(list.size(), 4 + kTilesX * kTilesY) << "header + a word per tile";
   const uint32_t count = list[3];  // FibletListHeader: dispatch x, y, z, count
   ASSERT_EQ(count, expected.size());
   EXPECT_EQ(list[0] * list[1] * list[2], count) << "the indirect dispatch is one workgroup per tile";
