@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <cstring>
 
+#include "gpu/leak_check_pins.h"
 #include "gpu/vk_check.h"
 
 namespace fibscope::gpu {
@@ -292,7 +293,12 @@ void VulkanInstance::release() {
     if (destroy) destroy(instance_, messenger_, nullptr);
     messenger_ = VK_NULL_HANDLE;
   }
-  if (instance_ != VK_NULL_HANDLE) vkDestroyInstance(instance_, nullptr);
+  if (instance_ != VK_NULL_HANDLE) {
+    // The driver goes with the instance: under LeakSanitizer keep it mapped
+    // so its per-process allocations stay reachable (gpu/leak_check_pins.h).
+    pinLibrariesForLeakChecks();
+    vkDestroyInstance(instance_, nullptr);
+  }
   instance_ = VK_NULL_HANDLE;
 }
 

@@ -4,9 +4,15 @@
 // zero-error check of every GPU test means something).
 #include <gtest/gtest.h>
 
+#include <link.h>
+
+#include <algorithm>
 #include <numeric>
+#include <set>
+#include <string>
 #include <vector>
 
+#include "gpu/leak_check_pins.h"
 #include "gpu/submit.h"
 #include "gpu_test_context.h"
 #include "test_support.h"
@@ -242,6 +248,37 @@ TEST_F(GpuContext, synchronisationValidationReportsAMissingBarrier) {
   for (const std::string& m : log().messages()) hazard |= m.find("SYNC-HAZARD-READ") != std::string::npos;
   EXPECT_TRUE(hazard) << "synchronisation validation is not active";
   log().clear();  // provoked on purpose
+}
+
+// The shared libraries mapped into this process now, by path.
+std::set<std::string> loadedLibraries() {
+  std::set<std::string> names;
+  dl_iterate_phdr(
+      [](dl_phdr_info* info, size_t, void* out) {
+        if (info->dlpi_name && info->dlpi_name[0] != '\0')
+          static_cast<std::set<std::string>*>(out)->insert(info->dlpi_name);
+        return 0;
+      },
+      &names);
+  return names;
+}
+
+TEST(GpuLeakCheckPins, theDriverStaysMappedAfterItsInstanceInLeakCheckedBuilds) {
+  // Under LeakSanitizer an unloaded driver's per-process allocations look
+  // leaked from an "<unknown module>" (gpu/leak_check_pins.h); the instance
+  // keeps every library it loaded mapped past vkDestroyInstance there.
+  if (!gpu::leakChecksPinLibraries()) GTEST_SKIP() << "only builds with AddressSanitizer pin the driver";
+  std::set<std::string> during;
+  try {
+    gpu::VulkanInstance instance(gpu::InstanceOptions{});
+    during = loadedLibraries();
+  } catch (const gpu::VulkanUnavailable& e) {
+    GTEST_SKIP() << "no Vulkan driver: " << e.what();
+  }
+  const std::set<std::string> after = loadedLibraries();
+  std::vector<std::string> unloaded;
+  std::set_difference(during.begin(), during.end(), after.begin(), after.end(), std::back_inserter(unloaded));
+  EXPECT_TRUE(unloaded.empty()) << "unloaded with the instance: " << unloaded.front();
 }
 
 TEST(GpuInfoCommand, missingVulkanDriverIsOneClearLine) {

@@ -5,9 +5,7 @@
 // bad teardown count too.
 #pragma once
 
-#include <dlfcn.h>
 #include <gtest/gtest.h>
-#include <link.h>
 
 #include <deque>
 #include <memory>
@@ -18,6 +16,7 @@
 #include "gpu/gpu_timer.h"
 #include "gpu/graphics_pipeline.h"
 #include "gpu/image.h"
+#include "gpu/leak_check_pins.h"
 #include "gpu/vulkan_context.h"
 
 namespace fibscope::test {
@@ -34,22 +33,9 @@ class GpuTest : public ::testing::Test {
     } catch (const gpu::VulkanUnavailable& e) {
       GTEST_SKIP() << "no usable Vulkan device: " << e.what();
     }
-    pinLoadedLibraries();
-  }
-
-  // The loader unloads the driver and the layers when the instance goes; a
-  // leak inside them is then reported by LeakSanitizer at exit from an
-  // "<unknown module>", which no suppression can name. Keeping every loaded
-  // library until exit lets tests/lsan_suppressions.txt name the driver's
-  // and layer's libraries (and only those).
-  static void pinLoadedLibraries() {
-    dl_iterate_phdr(
-        [](dl_phdr_info* info, size_t, void*) {
-          if (info->dlpi_name && info->dlpi_name[0] != '\0')
-            dlopen(info->dlpi_name, RTLD_LAZY | RTLD_NOLOAD | RTLD_NODELETE);
-          return 0;
-        },
-        nullptr);
+    // Pinned in this process whatever the build (gpu/leak_check_pins.h):
+    // the driver stays loaded across the tests of one run.
+    gpu::pinLoadedLibraries();
   }
 
   void TearDown() override {

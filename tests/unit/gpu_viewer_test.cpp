@@ -365,18 +365,17 @@ const std::string& processCacheDir() {
   return dir.path();
 }
 
-// LeakSanitizer off in the child: see gpu_cli_render_test.cpp.
+// The child is leak-checked under ASan: see gpu_cli_render_test.cpp.
 test::CommandResult runViewer(const std::string& args, const std::string& prefix = "",
                               const std::string& cache_dir = "") {
-  return test::runCommand(prefix + "ASAN_OPTIONS=\"${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0\" " +
-                          "FIBSCOPE_CACHE_DIR='" + (cache_dir.empty() ? processCacheDir() : cache_dir) + "' " +
+  return test::runCommand(prefix + "FIBSCOPE_CACHE_DIR='" + (cache_dir.empty() ? processCacheDir() : cache_dir) + "' " +
                           FIBSCOPE_EXE + " view --validate --phantom-streamlines 300 " + args);
 }
 
 class GpuViewer : public ::testing::Test {
  protected:
   void SetUp() override {
-    const auto r = test::runCommand(std::string("ASAN_OPTIONS=detect_leaks=0 ") + FIBSCOPE_EXE + " gpu-info");
+    const auto r = test::runFibscope("gpu-info");
     if (r.exit_code != 0) GTEST_SKIP() << "no usable Vulkan device: " << r.output;
   }
   // The scene (right half below the overlay) shows the tractogram, the
