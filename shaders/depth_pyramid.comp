@@ -9,10 +9,11 @@
 #extension GL_EXT_buffer_reference : require
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 
+#include "shared/workgroup.h"
 #include "shared/cull_push.h"
 #include "glsl/render_buffers.glsl"
 
-layout(local_size_x = 8, local_size_y = 8) in;  // kPixelGroupSize
+layout(local_size_x_id = WORKGROUP_SIZE_X_ID, local_size_y_id = WORKGROUP_SIZE_Y_ID) in;  // kPixelGroupSize
 
 layout(push_constant, std430) uniform Push { DepthPyramidPush pc; };
 

@@ -28,10 +28,11 @@
 #extension GL_EXT_buffer_reference : require
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 
+#include "shared/workgroup.h"
 #include "shared/cull_push.h"
 #include "glsl/fiblet_record.glsl"
 
-layout(local_size_x = 64) in;  // kCullGroupSize
+layout(local_size_x_id = WORKGROUP_SIZE_X_ID) in;  // kCullGroupSize
 
 layout(push_constant, std430) uniform Push { FibletCullPush pc; };
 

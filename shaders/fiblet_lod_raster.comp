@@ -10,12 +10,13 @@
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 #extension GL_EXT_shader_atomic_int64 : require
 
+#include "shared/workgroup.h"
 #include "shared/cull_push.h"
 #include "glsl/fiblet_record.glsl"
 #include "glsl/raster_segment.glsl"
 #include "glsl/tangent.glsl"
 
-layout(local_size_x = 64) in;  // the finalize pass's items_per_group
+layout(local_size_x_id = WORKGROUP_SIZE_X_ID) in;  // kLodRasterGroupSize: the finalize pass's items_per_group
 
 layout(push_constant, std430) uniform Push { FibletLodRasterPush pc; };
 

@@ -13,12 +13,13 @@
 #extension GL_EXT_buffer_reference : require
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 
+#include "shared/workgroup.h"
 #include "shared/render_push.h"
 #include "shared/scene_table.h"
 #include "glsl/fiblet_record.glsl"
 #include "glsl/tangent.glsl"
 
-layout(local_size_x = 8, local_size_y = 8) in;  // kPixelGroupSize
+layout(local_size_x_id = WORKGROUP_SIZE_X_ID, local_size_y_id = WORKGROUP_SIZE_Y_ID) in;  // kPixelGroupSize
 // True: pc.tangents is the rasters' tangent cache; false: decode.
 layout(constant_id = 0) const bool kTangentCache = true;
 

@@ -17,10 +17,11 @@
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 #extension GL_EXT_shader_atomic_int64 : require
 
+#include "shared/workgroup.h"
 #include "glsl/raw_tractogram.glsl"
 #include "glsl/raster_segment.glsl"
 
-layout(local_size_x = 64) in;  // kRawRasterGroupSize
+layout(local_size_x_id = WORKGROUP_SIZE_X_ID) in;  // kRawRasterGroupSize
 
 layout(push_constant, std430) uniform Push { RawRasterPush pc; };
 

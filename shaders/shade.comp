@@ -4,29 +4,39 @@
 // highlight colour of a selected fiber) times
 // the lighting (none, or illuminated lines: Zoeckler, Stalling, Hege 1996,
 // which light a line from its tangent alone: the normal is the one in the
-// plane of T and L that maximises the Phong terms), times the ambient
+// plane of T and L that maximises the Phong terms; surfaces: Blinn-Phong
+// from their normal), times the ambient
 // occlusion factor when ssao.comp ran, unselected fibers faded towards the
 // background when there is a selection, as RGBA8 (R in the low byte,
 // A = 255). Empty pixels get the background colour. Formulas:
-// shared/shade_push.h. One workgroup per covered tile (tile_classify.comp);
-// the other tiles hold the background already.
+// shared/shade_push.h. Colour mode, lighting and surfaces are
+// specialisation constants: each pipeline holds one combination's code.
+// One workgroup per covered tile (tile_classify.comp); the other tiles hold
+// the background already.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_buffer_reference : require
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 
 #include "shared/shade_push.h"
+#include "shared/workgroup.h"
 #include "glsl/shade_common.glsl"
 #include "glsl/tangent.glsl"
 
-layout(local_size_x = 8, local_size_y = 8) in;  // kPixelGroupSize
+layout(local_size_x_id = WORKGROUP_SIZE_X_ID, local_size_y_id = WORKGROUP_SIZE_Y_ID) in;  // kPixelGroupSize
+
+layout(constant_id = kShadeSpecColorMode) const uint COLOR_MODE = kShadeColorOrientation;
+layout(constant_id = kShadeSpecLighting) const uint LIGHTING = kShadeLightingIlluminated;
+layout(constant_id = kShadeSpecSurfaces) const bool SURFACES = false;
 
 layout(push_constant, std430) uniform Push { ShadePush pc; };
 
+layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer ShadeBlockRef { ShadeBlock b; };
 layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer AoRef { float values[]; };
 layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer ScalarRef { float values[]; };
 layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer WordRef { uint values[]; };
 layout(buffer_reference, std430, buffer_reference_align = 4) writeonly buffer ColorRef { uint values[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer SurfaceRef { SurfaceTexel texels[]; };
 
 uint packRgba8(vec3 c) {
   const uvec3 b = uvec3(clamp(c, 0.0, 1.0) * 255.0 + 0.5);
@@ -36,19 +46,30 @@ uint packRgba8(vec3 c) {
 vec3 unpackRgb8(uint c) { return vec3(c & 255u, (c >> 8) & 255u, (c >> 16) & 255u) / 255.0; }
 
 // The colormap entry of fiber scalar s (colormap.h: colormapIndex).
-vec3 scalarColor(float s) {
-  float t = pc.scalar_max > pc.scalar_min ? (s - pc.scalar_min) / (pc.scalar_max - pc.scalar_min) : 0.5;
+vec3 scalarColor(ShadeBlockRef block, float s) {
+  const float lo = block.b.scalar_min, hi = block.b.scalar_max;
+  float t = hi > lo ? (s - lo) / (hi - lo) : 0.5;
   if (isnan(s)) t = 0.0;
   const uint entry = uint(clamp(t, 0.0, 1.0) * float(kShadeColormapEntries - 1u) + 0.5);
-  return unpackRgb8(WordRef(pc.colormap).values[entry]);
+  return unpackRgb8(block.b.colormap[entry]);
+}
+
+// A unit normal in view space, as a colour.
+vec3 viewNormalColor(CameraBlock cam, vec3 n) {
+  return 0.5 + 0.5 * vec3(dot(n, cameraRight(cam)), dot(n, cameraUp(cam)), dot(n, cameraBack(cam)));
 }
 
 // The line's normal facing the eye, in view space, as a colour.
 vec3 normalColor(CameraBlock cam, vec3 t, vec3 v) {
   const vec3 towards = v - dot(v, t) * t;
   const float len = length(towards);
-  const vec3 n = len > kShadeNormalParallelEps ? towards / len : v;
-  return 0.5 + 0.5 * vec3(dot(n, cameraRight(cam)), dot(n, cameraUp(cam)), dot(n, cameraBack(cam)));
+  return viewNormalColor(cam, len > kShadeNormalParallelEps ? towards / len : v);
+}
+
+// The headlight in world space.
+vec3 lightDirection(CameraBlock cam) {
+  const vec3 lv = normalize(vec3(kShadeLightViewX, kShadeLightViewY, kShadeLightViewZ));
+  return lv.x * cameraRight(cam) + lv.y * cameraUp(cam) + lv.z * cameraBack(cam);
 }
 
 void main() {
@@ -56,37 +77,56 @@ void main() {
   if (!tilePixel(pc.tiles, pc.width, pc.height, p)) return;
   const uint index = p.y * pc.width + p.x;
   const GBufferTexel texel = GBufferRef(pc.gbuffer).texels[index];
-  const vec3 background = unpackRgb8(pc.background);
+  ShadeBlockRef block = ShadeBlockRef(pc.block);
+  const vec3 background = unpackRgb8(block.b.background);
   vec3 c = background;
   if (texel.fiber != kNoFiberId) {
     const CameraBlock cam = CameraRef(pc.camera).camera;
     const vec3 t = unpackTangent(texel.tangent);
     const vec3 v = pixelToEye(cam, p);
-    const bool known = texel.fiber < pc.fiber_count;
+    // A surface's normal and own colour (shared/gbuffer.h).
+    bool surface = false;
+    vec3 n = vec3(0.0);
+    uint own_color = 0u;
+    if (SURFACES && (texel.segment & kGBufferSurface) != 0u) {
+      const SurfaceTexel s = SurfaceRef(pc.surface).texels[index];
+      surface = true;
+      n = unpackTangent(s.normal);
+      if (dot(n, v) < 0.0) n = -n;
+      own_color = s.color;
+    }
+    const bool known = texel.fiber < block.b.fiber_count;
     bool selected = false, dimmed = false;
-    if (pc.selection_bits != 0ul && known) {
-      selected = (WordRef(pc.selection_bits).values[texel.fiber >> 5] & (1u << (texel.fiber & 31u))) != 0u;
+    if (block.b.selection_bits != 0ul && known) {
+      selected = (WordRef(block.b.selection_bits).values[texel.fiber >> 5] & (1u << (texel.fiber & 31u))) != 0u;
       dimmed = !selected;
     }
-    uint mode = pc.color_mode;
-    if (mode == kShadeColorScalar && (pc.fiber_scalars == 0ul || !known)) mode = kShadeColorOrientation;
-    if (selected) c = unpackRgb8(pc.highlight);
-    else if (mode == kShadeColorOrientation) c = abs(t);
-    else if (mode == kShadeColorPerFiber) c = fiberColor(texel.fiber);
-    else if (mode == kShadeColorScalar) c = scalarColor(ScalarRef(pc.fiber_scalars).values[texel.fiber]);
-    else if (mode == kShadeColorNormal) c = normalColor(cam, t, v);
-    else c = unpackRgb8(pc.solid);
-    if (pc.lighting == kShadeLightingIlluminated) {
-      const vec3 lv = normalize(vec3(kShadeLightViewX, kShadeLightViewY, kShadeLightViewZ));
-      const vec3 l = lv.x * cameraRight(cam) + lv.y * cameraUp(cam) + lv.z * cameraBack(cam);
-      const float lt = dot(l, t), vt = dot(v, t);
-      const float diffuse = sqrt(max(1.0 - lt * lt, 0.0));
-      const float cos_rv = max(diffuse * sqrt(max(1.0 - vt * vt, 0.0)) - lt * vt, 0.0);
-      const float specular = pow(cos_rv, pc.shininess);
-      c = c * (pc.ambient + pc.diffuse * diffuse) + vec3(pc.specular * specular);
+    if (selected) c = unpackRgb8(block.b.highlight);
+    else if (SURFACES && (own_color >> 24) != 0u) c = unpackRgb8(own_color);
+    else if (COLOR_MODE == kShadeColorOrientation) c = abs(t);
+    else if (COLOR_MODE == kShadeColorPerFiber) c = fiberColor(texel.fiber);
+    else if (COLOR_MODE == kShadeColorScalar)
+      c = known ? scalarColor(block, ScalarRef(block.b.fiber_scalars).values[texel.fiber]) : abs(t);
+    else if (COLOR_MODE == kShadeColorNormal) c = surface ? viewNormalColor(cam, n) : normalColor(cam, t, v);
+    else c = unpackRgb8(block.b.solid);
+    if (LIGHTING == kShadeLightingIlluminated) {
+      const vec3 l = lightDirection(cam);
+      const float ambient = block.b.ambient, diffuse_k = block.b.diffuse, specular_k = block.b.specular;
+      const float shininess = block.b.shininess;
+      if (surface) {
+        const float diffuse = max(dot(n, l), 0.0);
+        const float specular = pow(max(dot(n, normalize(l + v)), 0.0), shininess);
+        c = c * (ambient + diffuse_k * diffuse) + vec3(specular_k * specular);
+      } else {
+        const float lt = dot(l, t), vt = dot(v, t);
+        const float diffuse = sqrt(max(1.0 - lt * lt, 0.0));
+        const float cos_rv = max(diffuse * sqrt(max(1.0 - vt * vt, 0.0)) - lt * vt, 0.0);
+        const float specular = pow(cos_rv, shininess);
+        c = c * (ambient + diffuse_k * diffuse) + vec3(specular_k * specular);
+      }
     }
     if (pc.ao != 0ul) c *= AoRef(pc.ao).values[index];
-    if (dimmed) c = mix(c, background, pc.dim_unselected);
+    if (dimmed) c = mix(c, background, block.b.dim_unselected);
   }
   ColorRef(pc.color).values[index] = packRgba8(c);
 }

@@ -13,10 +13,11 @@
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_vote : require
 
+#include "shared/workgroup.h"
 #include "shared/shade_push.h"
 #include "glsl/render_buffers.glsl"
 
-layout(local_size_x = 8, local_size_y = 8) in;  // kPixelGroupSize
+layout(local_size_x_id = WORKGROUP_SIZE_X_ID, local_size_y_id = WORKGROUP_SIZE_Y_ID) in;  // kPixelGroupSize
 
 layout(push_constant, std430) uniform Push { TileClassifyPush pc; };
 

@@ -40,8 +40,11 @@ SHADER_NAMESPACE_BEGIN
 RENDER_CONST uint kRasterGroupSize = 64u;
 // Segments per workgroup in the raw-compute raster.
 RENDER_CONST uint kRawRasterGroupSize = 64u;
-// Fiblets per workgroup in the cull passes.
+// Fiblets per workgroup in the cull passes (and the bounds pass).
 RENDER_CONST uint kCullGroupSize = 64u;
+// Fiblets per workgroup of the far-view LoD raster (one segment each); the
+// LoD list is finalised for this many items a group.
+RENDER_CONST uint kLodRasterGroupSize = 64u;
 // Per-pixel passes (clear, resolve, shade) run in 8 x 8 tiles.
 RENDER_CONST uint kPixelGroupSize = 8u;
 
@@ -54,6 +57,9 @@ RENDER_CONST float kMaxLineWidthPx = 4.0f;
 
 // Marks an empty G-buffer texel (fiber field) and "no fiber" elsewhere.
 RENDER_CONST uint kNoFiberId = 0xFFFFFFFFu;
+// The fiber field of a drawn pixel that belongs to no fiber (an anatomical
+// slice): covered for shading and AO, no fiber for picking and attributes.
+RENDER_CONST uint kNoFiberObject = 0xFFFFFFFEu;
 
 // Tiles of kPixelGroupSize pixels covering `pixels` along one axis: the
 // workgroups of a per-pixel pass.

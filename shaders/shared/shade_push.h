@@ -22,7 +22,7 @@
 
 SHADER_NAMESPACE_BEGIN
 
-// ShadePush::color_mode (RenderSettings::color).
+// The colour mode (RenderSettings::color): shade.comp's kShadeSpecColorMode.
 SHADE_CONST uint kShadeColorSolid = 0u;
 SHADE_CONST uint kShadeColorOrientation = 1u;
 SHADE_CONST uint kShadeColorPerFiber = 2u;
@@ -33,7 +33,7 @@ SHADE_CONST uint kShadeColormapEntries = 256u;
 // ColorMode::Normal: below this |V - (V.T) T| the line is seen end-on and
 // N = V (the tangent's 16-bit octahedral encoding is good to ~1e-4).
 SHADE_CONST float kShadeNormalParallelEps = 1e-3f;
-// ShadePush::lighting (RenderSettings::lighting).
+// The lighting (RenderSettings::lighting): shade.comp's kShadeSpecLighting.
 SHADE_CONST uint kShadeLightingNone = 0u;
 SHADE_CONST uint kShadeLightingIlluminated = 1u;
 
@@ -114,36 +114,54 @@ struct SsaoBlurPush {
   uint pad0;
 };
 
-// shade.comp: per pixel, base colour (color_mode) times lighting, times the
-// ambient-occlusion factor when ao != 0, packed as RGBA8 (R in the low byte,
-// A = 255), in the covered tiles (one workgroup each; the others hold the
-// background already); empty pixels get the background colour. Illuminated lines
-// (Zoeckler, Stalling, Hege 1996) with T the tangent, L the light and V the
-// direction towards the eye:
+// shade.comp: per pixel, base colour (the colour mode) times lighting,
+// times the ambient-occlusion factor when ao != 0, packed as RGBA8 (R in
+// the low byte, A = 255), in the covered tiles (one workgroup each; the
+// others hold the background already); empty pixels get the background
+// colour. The colour mode, the lighting and whether the frame has surfaces
+// are specialisation constants (kShadeSpec*), one pipeline per combination,
+// so no pixel pays for the branches of the others; the parameters are in a
+// ShadeBlock that the pass writes into its own buffer each frame.
+// Illuminated lines (Zoeckler, Stalling, Hege 1996) with T the tangent, L
+// the light and V the direction towards the eye:
 //   diffuse  = sqrt(1 - (L.T)^2)
 //   specular = max(0, sqrt(1 - (L.T)^2) sqrt(1 - (V.T)^2) - (L.T)(V.T))^shininess
 //   colour   = base * (ambient + diffuse_k * diffuse) + specular_k * specular
+// Surface pixels (GBufferTexel::segment has kGBufferSurface; their normal N
+// and colour come from the surface target, N turned towards the eye) take
+// Blinn-Phong with the same light and coefficients instead:
+//   diffuse  = max(0, N.L), specular = max(0, N.H)^shininess, H = normalize(L + V)
+// and their own colour where its alpha is > 0 (a slice), else the colour
+// mode's (Normal: N itself).
 // Base colours: Scalar reads fiber_scalars[fiber] and the colormap table
 // (entry round(255 t), t = (s - scalar_min) / (scalar_max - scalar_min)
-// clamped, NaN -> 0, max == min -> 0.5); without scalars (or a fiber id >=
-// fiber_count) it falls back to Orientation. Normal: 0.5 + 0.5 N in view
-// space, N = normalize(V - (V.T) T), or V when that is shorter than
-// kShadeNormalParallelEps. Selection (selection_bits != 0): selected fibers
-// take the highlight colour as base; unselected ones end as
-// mix(colour, background, dim_unselected) after lighting and occlusion.
+// clamped, NaN -> 0, max == min -> 0.5); a fiber id >= fiber_count falls
+// back to Orientation (the frame without scalars uses the Orientation
+// pipeline). Normal: 0.5 + 0.5 N in view space, N = normalize(V - (V.T) T),
+// or V when that is shorter than kShadeNormalParallelEps. Selection
+// (selection_bits != 0): selected fibers take the highlight colour as base;
+// unselected ones end as mix(colour, background, dim_unselected) after
+// lighting and occlusion.
+SHADE_CONST uint kShadeSpecColorMode = 0u;  // constant_id: kShadeColor*
+SHADE_CONST uint kShadeSpecLighting = 1u;   // constant_id: kShadeLighting*
+SHADE_CONST uint kShadeSpecSurfaces = 2u;   // constant_id: 1 when the frame has surfaces
 struct ShadePush {
   uint64_t camera;
   uint64_t gbuffer;
-  uint64_t ao;              // float per pixel, or 0: no ambient occlusion
-  uint64_t color;           // uint per pixel (written)
-  uint64_t colormap;        // kShadeColormapEntries RGBA8 uints: the chosen colormap's table
-  uint64_t fiber_scalars;   // float per fiber, or 0
-  uint64_t selection_bits;  // uint words, bit f % 32 of word f / 32; or 0: no selection
-  uint64_t tiles;           // the covered tiles (tile_classify.comp): one workgroup each
+  uint64_t surface;  // SurfaceTexel per pixel (surface pipelines only), or 0
+  uint64_t ao;       // float per pixel, or 0: no ambient occlusion
+  uint64_t color;    // uint per pixel (written)
+  uint64_t tiles;    // the covered tiles (tile_classify.comp): one workgroup each
+  uint64_t block;    // ShadeBlock
   uint width;
   uint height;
-  uint color_mode;
-  uint lighting;
+};
+
+// The shading parameters of one frame (written by the shade pass with the
+// frame's commands).
+struct ShadeBlock {
+  uint64_t fiber_scalars;   // float per fiber, or 0
+  uint64_t selection_bits;  // uint words, bit f % 32 of word f / 32; or 0: no selection
   uint solid;       // RGBA8: the solid base colour (8 bits a channel, as the image)
   uint background;  // RGBA8 (what the image stores anyway)
   float ambient;
@@ -156,6 +174,7 @@ struct ShadePush {
   float dim_unselected;
   uint fiber_count;  // fibers the scalars and selection bits cover
   uint pad0;
+  uint colormap[kShadeColormapEntries];  // RGBA8: the chosen colormap's table
 };
 
 // fxaa.comp: FXAA in the manner of Lottes' FXAA 3.11 "quality" preset, on
@@ -193,10 +212,11 @@ SHADER_NAMESPACE_END
 static_assert(sizeof(fibscope::shader::TileClassifyPush) == 32, "");
 static_assert(sizeof(fibscope::shader::SsaoPush) == 64, "");
 static_assert(sizeof(fibscope::shader::SsaoBlurPush) == 64, "");
-// 128 bytes: the smallest maxPushConstantsSize Vulkan guarantees.
-static_assert(sizeof(fibscope::shader::ShadePush) == 128, "");
-static_assert(offsetof(fibscope::shader::ShadePush, width) == 64, "scalars follow the eight addresses");
-static_assert(offsetof(fibscope::shader::ShadePush, fiber_count) == 120, "");
+static_assert(sizeof(fibscope::shader::ShadePush) == 64, "");
+static_assert(offsetof(fibscope::shader::ShadePush, width) == 56, "scalars follow the seven addresses");
+static_assert(offsetof(fibscope::shader::ShadeBlock, solid) == 16, "");
+static_assert(offsetof(fibscope::shader::ShadeBlock, colormap) == 64, "");
+static_assert(sizeof(fibscope::shader::ShadeBlock) == 64 + 4 * fibscope::shader::kShadeColormapEntries, "");
 static_assert(sizeof(fibscope::shader::FxaaPush) == 40, "");
 #endif
 

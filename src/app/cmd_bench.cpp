@@ -51,7 +51,7 @@ std::vector<Variant> variantsFrom(const BenchOptions& o) {
   const RenderSettings base = renderSettingsFrom(o.render);
   std::vector<std::string> specs;
   if (o.compare.empty()) {
-    specs.push_back(o.render.pipeline + "/" + o.render.culling);
+    specs.push_back(std::string(renderPipelineName(base.pipeline)) + "/" + std::string(cullingModeName(base.culling)));
   } else {
     size_t start = 0;
     while (start <= o.compare.size()) {

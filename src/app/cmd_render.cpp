@@ -74,10 +74,11 @@ void runRender(const RenderCommandOptions& o) {
     std::unique_ptr<gpu::VulkanContext> context;
     std::unique_ptr<FrameRenderer> renderer;  // destroyed before the context
   };
-  std::future<Device> making = std::async(std::launch::async, [&o, width, height] {
+  std::future<Device> making = std::async(std::launch::async, [&o, &settings, width, height] {
     Device d;
     d.context = createRenderContext(o.render);
     d.renderer = std::make_unique<FrameRenderer>(*d.context, width, height);
+    d.renderer->prepare(settings);  // this frame's shader variants
     return d;
   });
   std::optional<Device> device;
@@ -122,7 +123,7 @@ void addRenderCommand(CLI::App& app) {
   // One frame has no previous frame to learn visibility from: two-phase
   // culling would draw everything in its first phase and then only add a
   // depth pyramid and a second cull. The frustum test and LoD still pay.
-  o->render.culling = "frustum";
+  o->render.defaults.culling = CullingMode::Frustum;
   addRenderCliOptions(cmd, o->render);
   cmd->add_option("--view", o->view, "sagittal | coronal | axial");
   cmd->add_option("--camera", o->camera, "AZ,EL,DIST: orbit angles in degrees and distance factor (0: framed snugly, 1: the bounding sphere fits)");

@@ -33,7 +33,7 @@ void runView(ViewCommandOptions o) {
   v.phantom_streamlines = o.render.phantom_streamlines;
   parseFrameSize(o.render.size, v.width, v.height);
   v.settings = renderSettingsFrom(o.render);
-  v.keep_scalar_range = !o.render.scalar_range.empty();
+  v.keep_scalar_range = o.render.gave("scalar-range");
   if (!o.screenshot.empty() && (o.screenshot.size() < 5 || o.screenshot.substr(o.screenshot.size() - 4) != ".png"))
     throw Error("--screenshot: the output must be a .png file, got '" + o.screenshot + "'");
   v.screenshot = o.screenshot;

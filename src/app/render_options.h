@@ -3,8 +3,11 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <map>
 #include <memory>
 #include <string>
+#include <string_view>
 
 #include "gpu/vulkan_context.h"
 #include "render/gpu_dataset.h"
@@ -23,27 +26,24 @@ struct RenderCliOptions {
   std::string device;
   bool validate = false;
   std::string size = "1920x1080";
-  std::string pipeline = "compute";
-  std::string culling = "two-phase";
-  std::string color = "orientation";
-  std::string lighting = "illuminated";
-  bool no_ssao = false;
-  int ao_scales = 1;
-  bool fxaa = false;
-  std::string colormap = "viridis";
-  std::string scalar_range;  // "MIN,MAX"; empty: the scalars' own range
-  float line_width = 1.0f;
-  float lod_pixels = 4.0f;  // far-view LoD: fiblets projected smaller drawn as one segment (0: off)
-  std::string background = "0,0,0";
+  // The settings before the command line's (a command may change them
+  // before addRenderCliOptions, e.g. render's frustum culling), then one
+  // option per entry of render/settings_table.h: the text given for each
+  // (empty: not given), and the flags (--fxaa, or --no-ssao for a flag on
+  // by default).
+  RenderSettings defaults;
+  std::map<std::string, std::string, std::less<>> values;
+  std::map<std::string, bool, std::less<>> flags;
+  // Whether the command line gave the setting `name`.
+  bool gave(std::string_view name) const;
 };
 
-// Registers the options on `cmd`.
+// Registers the options on `cmd`: every setting of the table as --NAME
+// (its help and default from the table and `options.defaults`).
 void addRenderCliOptions(CLI::App* cmd, RenderCliOptions& options);
 
-// The settings and frame size the options name. Throws Error (one line) for
-// an unknown name, a malformed size ("WxH", 1 to 16384 each) or background
-// ("R,G,B" in [0, 1]), a line width outside [1, 4], AO scales outside
-// [1, 4], or a malformed scalar range ("MIN,MAX", finite, MIN <= MAX).
+// The settings the options name. Throws Error (one line) naming the option
+// and what it expects (render/settings_table.h: setSetting).
 RenderSettings renderSettingsFrom(const RenderCliOptions& options);
 void parseFrameSize(const std::string& text, uint32_t& width, uint32_t& height);
 

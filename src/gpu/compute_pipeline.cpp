@@ -2,15 +2,19 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <utility>
 #include <vector>
 
 #include "gpu/shader_library.h"
+#include "shared/workgroup.h"
 #include "gpu/vk_check.h"
 
 namespace fibscope::gpu {
 
-ComputePipeline createComputePipeline(const VulkanContext& context, std::string_view shader,
-                                      uint32_t push_constant_bytes, std::span<const uint32_t> specialization) {
+namespace {
+
+ComputePipeline createPipeline(const VulkanContext& context, std::string_view shader, uint32_t push_constant_bytes,
+                               std::span<const uint32_t> specialization, const WorkgroupSize* local) {
   const std::span<const uint32_t> words = shaderWords(shader);
   ComputePipeline result;
   result.name = std::string(shader);
@@ -38,9 +42,17 @@ ComputePipeline createComputePipeline(const VulkanContext& context, std::string_
   }
 
   std::vector<VkSpecializationMapEntry> entries;
+  std::vector<uint32_t> values(specialization.begin(), specialization.end());
   for (uint32_t i = 0; i < specialization.size(); ++i) entries.push_back({i, 4 * i, 4});
-  VkSpecializationInfo spec{uint32_t(entries.size()), entries.data(), specialization.size_bytes(),
-                            specialization.data()};
+  if (local) {
+    for (const auto& [id, value] : {std::pair{uint32_t(WORKGROUP_SIZE_X_ID), local->x},
+                                    std::pair{uint32_t(WORKGROUP_SIZE_Y_ID), local->y},
+                                    std::pair{uint32_t(WORKGROUP_SIZE_Z_ID), local->z}}) {
+      entries.push_back({id, uint32_t(4 * values.size()), 4});
+      values.push_back(value);
+    }
+  }
+  VkSpecializationInfo spec{uint32_t(entries.size()), entries.data(), values.size() * sizeof(uint32_t), values.data()};
   VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
   info.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
   info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
@@ -58,14 +70,28 @@ ComputePipeline createComputePipeline(const VulkanContext& context, std::string_
   return result;
 }
 
+}  // namespace
+
+ComputePipeline createComputePipeline(const VulkanContext& context, std::string_view shader,
+                                      uint32_t push_constant_bytes, std::span<const uint32_t> specialization) {
+  return createPipeline(context, shader, push_constant_bytes, specialization, nullptr);
+}
+
+ComputePipeline createComputePipeline(const VulkanContext& context, std::string_view shader,
+                                      uint32_t push_constant_bytes, WorkgroupSize local,
+                                      std::span<const uint32_t> specialization) {
+  return createPipeline(context, shader, push_constant_bytes, specialization, &local);
+}
+
 void destroyComputePipeline(const VulkanContext& context, ComputePipeline& pipeline) {
   if (pipeline.pipeline != VK_NULL_HANDLE) vkDestroyPipeline(context.device(), pipeline.pipeline, nullptr);
   if (pipeline.layout != VK_NULL_HANDLE) vkDestroyPipelineLayout(context.device(), pipeline.layout, nullptr);
   pipeline = ComputePipeline{};
 }
 
-void recordDispatch(VkCommandBuffer cmd, const ComputePipeline& pipeline, const void* push, uint32_t push_bytes,
-                    uint32_t groups_x, uint32_t groups_y, uint32_t groups_z) {
+namespace {
+
+void bindAndPush(VkCommandBuffer cmd, const ComputePipeline& pipeline, const void* push, uint32_t push_bytes) {
   if (push_bytes != pipeline.push_constant_bytes) {
     // A C++ struct that disagrees with the shader's block: a bug, found the
     // first time the pass runs.
@@ -75,7 +101,20 @@ void recordDispatch(VkCommandBuffer cmd, const ComputePipeline& pipeline, const 
   }
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.pipeline);
   if (push_bytes > 0) vkCmdPushConstants(cmd, pipeline.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, push_bytes, push);
+}
+
+}  // namespace
+
+void recordDispatch(VkCommandBuffer cmd, const ComputePipeline& pipeline, const void* push, uint32_t push_bytes,
+                    uint32_t groups_x, uint32_t groups_y, uint32_t groups_z) {
+  bindAndPush(cmd, pipeline, push, push_bytes);
   vkCmdDispatch(cmd, groups_x, groups_y, groups_z);
+}
+
+void recordDispatchIndirect(VkCommandBuffer cmd, const ComputePipeline& pipeline, const void* push, uint32_t push_bytes,
+                            VkBuffer indirect, VkDeviceSize offset) {
+  bindAndPush(cmd, pipeline, push, push_bytes);
+  vkCmdDispatchIndirect(cmd, indirect, offset);
 }
 
 DispatchGrid dispatchGrid(const VulkanContext& context, uint64_t count) {

@@ -29,6 +29,17 @@ struct ComputePipeline {
 // the pipeline.
 ComputePipeline createComputePipeline(const VulkanContext& context, std::string_view shader,
                                       uint32_t push_constant_bytes, std::span<const uint32_t> specialization = {});
+
+// The workgroup size of a shader that declares it through
+// shared/workgroup.h's specialisation constants.
+struct WorkgroupSize {
+  uint32_t x = 1, y = 1, z = 1;
+};
+// As above, and the shader's workgroup size is `local` (its constants
+// WORKGROUP_SIZE_X_ID ... set to it).
+ComputePipeline createComputePipeline(const VulkanContext& context, std::string_view shader,
+                                      uint32_t push_constant_bytes, WorkgroupSize local,
+                                      std::span<const uint32_t> specialization = {});
 void destroyComputePipeline(const VulkanContext& context, ComputePipeline& pipeline);
 
 // Binds the pipeline, pushes `push` (whose size must be the pipeline's
@@ -40,6 +51,17 @@ template <typename PushConstants>
 void recordDispatch(VkCommandBuffer cmd, const ComputePipeline& pipeline, const PushConstants& push, uint32_t groups_x,
                     uint32_t groups_y = 1, uint32_t groups_z = 1) {
   recordDispatch(cmd, pipeline, &push, uint32_t(sizeof(PushConstants)), groups_x, groups_y, groups_z);
+}
+
+// The same from `indirect` at `offset` (a VkDispatchIndirectCommand the
+// device wrote and made visible to indirect reads), with the same check of
+// the push-constant size.
+void recordDispatchIndirect(VkCommandBuffer cmd, const ComputePipeline& pipeline, const void* push, uint32_t push_bytes,
+                            VkBuffer indirect, VkDeviceSize offset);
+template <typename PushConstants>
+void recordDispatchIndirect(VkCommandBuffer cmd, const ComputePipeline& pipeline, const PushConstants& push,
+                            VkBuffer indirect, VkDeviceSize offset = 0) {
+  recordDispatchIndirect(cmd, pipeline, &push, uint32_t(sizeof(PushConstants)), indirect, offset);
 }
 
 // Workgroups for `count` items as a 2D grid (x at most the device's limit);

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "gpu/pass_scope.h"
 #include "gpu/submit.h"
 #include "shared/cull_push.h"
 #include "shared/fiblet_list.h"
@@ -15,27 +16,12 @@ namespace fibscope {
 namespace {
 
 constexpr VkDeviceSize kCountOffset = offsetof(shader::FibletListHeader, count);
-constexpr uint32_t kLodItemsPerGroup = 64;  // fiblet_lod_raster.comp's local size
-
-// Finalised lists to the indirect dispatch and the rasters' reads.
-void computeToIndirect(VkCommandBuffer cmd) {
-  gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                     VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                     VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
-}
-
 // Earlier compute and indirect uses of the lists before transfers
 // (statistics copies, counter resets) touch them.
 void computeToTransfer(VkCommandBuffer cmd) {
   gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
                      VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_TRANSFER_BIT,
                      VK_ACCESS_2_TRANSFER_READ_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT);
-}
-
-void transferToCompute(VkCommandBuffer cmd) {
-  gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                     VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                     VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
 }
 
 // Copies each region's two list counts into its stats slots 2 * phase and
@@ -87,7 +73,7 @@ void recordFinalize(VkCommandBuffer cmd, const gpu::VulkanContext& context, cons
     push.items_per_group = fiblet_passes.raster_fiblets_per_group;  // fiblet_raster.comp (1 on GPUs)
     gpu::recordDispatch(cmd, passes.finalize, push, 1);
     push.list = buffers.lod_list.address + r.list_offset;
-    push.items_per_group = kLodItemsPerGroup;
+    push.items_per_group = shader::kLodRasterGroupSize;
     gpu::recordDispatch(cmd, passes.finalize, push, 1);
   }
 }
@@ -101,49 +87,53 @@ void recordLodRaster(VkCommandBuffer cmd, const CullPasses& passes, const SceneE
   push.list = buffers.lod_list.address + region.list_offset;
   push.tangents = frame.tangents.address;
   push.fiblet_base = entry.fiblet_base;
-  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, passes.lod_raster.pipeline);
-  vkCmdPushConstants(cmd, passes.lod_raster.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
-  vkCmdDispatchIndirect(cmd, buffers.lod_list.buffer, region.list_offset);
+  gpu::recordDispatchIndirect(cmd, passes.lod_raster, push, buffers.lod_list.buffer, region.list_offset);
 }
 
-// One cull phase over every dataset: counters reset -> culls -> finalizes,
-// then every dataset's two rasters (atomicMin into one visibility buffer:
-// no barrier between datasets).
+// One cull phase over every dataset: counters reset -> culls -> finalizes
+// (pass `cull_name`, its lists then ready for indirect dispatch), then
+// every dataset's two rasters (pass `raster_name`; atomicMin into one
+// visibility buffer: no barrier between datasets), their writes before
+// later compute passes.
 void recordPhase(VkCommandBuffer cmd, const gpu::VulkanContext& context, const CullPasses& passes,
                  const FibletPasses& fiblet_passes, const SceneLayout& scene, const GpuFrameTargets& frame,
-                 const CullBuffers& buffers, uint32_t mode, const CullFrame& cull, gpu::GpuTimer& timer,
+                 const CullBuffers& buffers, uint32_t mode, const CullFrame& cull, gpu::GpuTimer* timer,
                  const char* cull_name, const char* raster_name) {
-  gpu::beginPass(cmd, timer, cull_name);
-  resetLists(cmd, buffers);
-  transferToCompute(cmd);
-  for (size_t i = 0; i < scene.entries.size(); ++i)
-    recordCull(cmd, context, passes, *scene.entries[i].dataset, buffers.regions[i], frame, buffers, mode, cull);
-  gpu::computeToComputeBarrier(cmd);
-  recordFinalize(cmd, context, passes, buffers, fiblet_passes);
-  gpu::endPass(cmd, timer);
-  computeToIndirect(cmd);
-
-  gpu::beginPass(cmd, timer, raster_name);
+  {
+    gpu::PassScope pass(cmd, timer, cull_name, gpu::kComputeToIndirect);
+    resetLists(cmd, buffers);
+    gpu::recordBarrier(cmd, gpu::kTransferToCompute);
+    for (size_t i = 0; i < scene.entries.size(); ++i)
+      recordCull(cmd, context, passes, *scene.entries[i].dataset, buffers.regions[i], frame, buffers, mode, cull);
+    gpu::computeToComputeBarrier(cmd);
+    recordFinalize(cmd, context, passes, buffers, fiblet_passes);
+  }
+  gpu::PassScope pass(cmd, timer, raster_name, gpu::kComputeToCompute);
   for (size_t i = 0; i < scene.entries.size(); ++i) {
     const CullRegion& region = buffers.regions[i];
     recordFibletRasterList(cmd, fiblet_passes, *scene.entries[i].dataset, frame, buffers.list, region.list_offset,
                            scene.entries[i].fiblet_base);
     recordLodRaster(cmd, passes, scene.entries[i], region, frame, buffers);
   }
-  gpu::endPass(cmd, timer);
 }
 
 }  // namespace
 
+gpu::ComputePipeline createListFinalizePipeline(const gpu::VulkanContext& context) {
+  return gpu::createComputePipeline(context, "fiblet_list_finalize.comp", sizeof(shader::FibletListFinalizePush));
+}
+
 CullPasses createCullPasses(const gpu::VulkanContext& context) {
   CullPasses passes;
   try {
-    passes.cull = gpu::createComputePipeline(context, "fiblet_cull.comp", sizeof(shader::FibletCullPush));
-    passes.finalize =
-        gpu::createComputePipeline(context, "fiblet_list_finalize.comp", sizeof(shader::FibletListFinalizePush));
-    passes.pyramid = gpu::createComputePipeline(context, "depth_pyramid.comp", sizeof(shader::DepthPyramidPush));
+    passes.cull = gpu::createComputePipeline(context, "fiblet_cull.comp", sizeof(shader::FibletCullPush),
+                                             gpu::WorkgroupSize{shader::kCullGroupSize});
+    passes.finalize = createListFinalizePipeline(context);
+    passes.pyramid = gpu::createComputePipeline(context, "depth_pyramid.comp", sizeof(shader::DepthPyramidPush),
+                                                gpu::WorkgroupSize{shader::kPixelGroupSize, shader::kPixelGroupSize});
     passes.lod_raster =
-        gpu::createComputePipeline(context, "fiblet_lod_raster.comp", sizeof(shader::FibletLodRasterPush));
+        gpu::createComputePipeline(context, "fiblet_lod_raster.comp", sizeof(shader::FibletLodRasterPush),
+                                   gpu::WorkgroupSize{shader::kLodRasterGroupSize});
   } catch (...) {
     destroyCullPasses(context, passes);
     throw;
@@ -255,7 +245,7 @@ float cullFocalPixels(const Camera& camera) {
 
 void recordCulledRaster(VkCommandBuffer cmd, const gpu::VulkanContext& context, const CullPasses& passes,
                         const FibletPasses& fiblet_passes, const SceneLayout& scene, const GpuFrameTargets& frame,
-                        CullBuffers& buffers, const CullFrame& cull, gpu::GpuTimer& timer) {
+                        CullBuffers& buffers, const CullFrame& cull, gpu::GpuTimer* timer) {
   if (scene.entries.size() != buffers.regions.size())
     throw Error("cull: the buffers were prepared for " + std::to_string(buffers.regions.size()) + " datasets, the scene has " +
                 std::to_string(scene.entries.size()));
@@ -270,17 +260,16 @@ void recordCulledRaster(VkCommandBuffer cmd, const gpu::VulkanContext& context, 
               two_phase ? shader::kCullPhase1 : shader::kCullFrustum, cull, timer, two_phase ? "cull 1" : "cull",
               two_phase ? "raster 1" : "raster");
   if (two_phase) {
-    // The phase-1 raster's writes to the pyramid; its reads of the lists
-    // before their counts are copied and reset.
-    gpu::computeToComputeBarrier(cmd);
+    // (The phase-1 raster's writes before the pyramid: its pass's barrier.)
+    // Its reads of the lists before their counts are copied and reset.
     computeToTransfer(cmd);
-    gpu::beginPass(cmd, timer, "depth pyramid");
-    copyCounts(cmd, buffers, 0);
-    recordDepthPyramid(cmd, passes, frame, buffers);
-    gpu::endPass(cmd, timer);
+    {
+      gpu::PassScope pass(cmd, timer, "depth pyramid", gpu::kComputeToCompute);
+      copyCounts(cmd, buffers, 0);
+      recordDepthPyramid(cmd, passes, frame, buffers);
+    }
     // The copies read the counts before recordPhase's reset writes them.
     gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, 0, VK_PIPELINE_STAGE_2_TRANSFER_BIT, 0);
-    gpu::computeToComputeBarrier(cmd);
     recordPhase(cmd, context, passes, fiblet_passes, scene, frame, buffers, shader::kCullPhase2, cull, timer,
                 "cull 2", "raster 2");
   }

@@ -38,6 +38,9 @@ struct CullPasses {
 };
 
 CullPasses createCullPasses(const gpu::VulkanContext& context);
+// fiblet_list_finalize.comp (one invocation: it turns a list's count into
+// its indirect dispatch), which the tile list of the shading uses too.
+gpu::ComputePipeline createListFinalizePipeline(const gpu::VulkanContext& context);
 void destroyCullPasses(const gpu::VulkanContext& context, CullPasses& passes);
 
 // Where one drawn dataset's lists and visible bits lie in CullBuffers.
@@ -106,10 +109,9 @@ float cullFocalPixels(const Camera& camera);
 // Records the culled decode + raster of every dataset of `scene` (regions
 // prepared by prepareCullBuffers for its datasets' fiblet counts, in
 // order) into frame.visibility (cleared by the caller, camera block
-// written, both made visible to compute), with
-// timestamps per pass on `timer` and barriers between its passes; ends with
-// the raster's compute writes (the caller's barrier before the resolve
-// covers them) and the statistics copied for readCullStats. TwoPhase
+// written, both made visible to compute), each pass in a gpu::PassScope on
+// `timer` (may be null); the raster's writes are visible to later compute
+// passes when it returns, and the statistics copied for readCullStats. TwoPhase
 // starts from "every fiblet visible" when the history is not valid (first
 // frame, new size or scene, a frame of another mode in between): phase 1
 // then draws everything in the frustum and phase 2 learns the true bits at
@@ -123,7 +125,7 @@ float cullFocalPixels(const Camera& camera);
 //             pyramid -> phase-2 cull -> finalize -> raster + LoD raster.
 void recordCulledRaster(VkCommandBuffer cmd, const gpu::VulkanContext& context, const CullPasses& passes,
                         const FibletPasses& fiblet_passes, const SceneLayout& scene, const GpuFrameTargets& frame,
-                        CullBuffers& buffers, const CullFrame& cull, gpu::GpuTimer& timer);
+                        CullBuffers& buffers, const CullFrame& cull, gpu::GpuTimer* timer);
 
 // The fiblets drawn by the last recorded frame (summed over its datasets),
 // once it has completed.

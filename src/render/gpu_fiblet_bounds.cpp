@@ -8,7 +8,8 @@ namespace fibscope {
 
 FibletBoundsPass createFibletBoundsPass(const gpu::VulkanContext& context) {
   FibletBoundsPass pass;
-  pass.bounds = gpu::createComputePipeline(context, "fiblet_bounds.comp", sizeof(shader::FibletBoundsPush));
+  pass.bounds = gpu::createComputePipeline(context, "fiblet_bounds.comp", sizeof(shader::FibletBoundsPush),
+                                           gpu::WorkgroupSize{shader::kCullGroupSize});
   return pass;
 }
 

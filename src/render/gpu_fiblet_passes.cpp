@@ -80,9 +80,11 @@ FibletPasses createFibletPasses(const gpu::VulkanContext& context, uint32_t rast
     // both sides of a branch, and the decode is most of the shader.
     const uint32_t cache[] = {1u}, decode[] = {0u};
     passes.resolve =
-        gpu::createComputePipeline(context, "fiblet_resolve.comp", sizeof(shader::FibletResolvePush), cache);
+        gpu::createComputePipeline(context, "fiblet_resolve.comp", sizeof(shader::FibletResolvePush),
+                                   gpu::WorkgroupSize{shader::kPixelGroupSize, shader::kPixelGroupSize}, cache);
     passes.resolve_decode =
-        gpu::createComputePipeline(context, "fiblet_resolve.comp", sizeof(shader::FibletResolvePush), decode);
+        gpu::createComputePipeline(context, "fiblet_resolve.comp", sizeof(shader::FibletResolvePush),
+                                   gpu::WorkgroupSize{shader::kPixelGroupSize, shader::kPixelGroupSize}, decode);
   } catch (...) {
     destroyFibletPasses(context, passes);
     throw;
@@ -125,9 +127,7 @@ void recordFibletRasterList(VkCommandBuffer cmd, const FibletPasses& passes, con
   push.list = list.address + list_offset;
   push.tangents = frame.tangents.address;
   push.fiblet_base = fiblet_base;
-  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, passes.raster.pipeline);
-  vkCmdPushConstants(cmd, passes.raster.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
-  vkCmdDispatchIndirect(cmd, list.buffer, list_offset);
+  gpu::recordDispatchIndirect(cmd, passes.raster, push, list.buffer, list_offset);
 }
 
 void recordFibletResolve(VkCommandBuffer cmd, const FibletPasses& passes, VkDeviceAddress scene_table,

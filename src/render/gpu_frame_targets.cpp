@@ -5,6 +5,7 @@
 
 #include "core/error.h"
 #include "render/gpu_dataset.h"
+#include "shared/fiblet_list.h"
 #include "shared/render_config.h"
 
 namespace fibscope {
@@ -26,6 +27,13 @@ GpuFrameTargets createFrameTargets(const gpu::VulkanContext& context, uint32_t w
                                      gpu::MemoryUse::DeviceLocal);
     t.gbuffer = gpu::createBuffer(context, t.pixels() * sizeof(shader::GBufferTexel), gpu::MemoryUse::DeviceLocal);
     t.color = gpu::createBuffer(context, t.pixels() * sizeof(uint32_t), gpu::MemoryUse::DeviceLocal);
+    // float and RGBA8 are both 4 bytes a pixel.
+    t.ao = gpu::createBuffer(context, t.pixels() * sizeof(float), gpu::MemoryUse::DeviceLocal);
+    t.ao_blur = gpu::createBuffer(context, t.pixels() * sizeof(float), gpu::MemoryUse::DeviceLocal);
+    t.shaded = gpu::createBuffer(context, t.pixels() * sizeof(uint32_t), gpu::MemoryUse::DeviceLocal);
+    t.tile_flags = gpu::createBuffer(context, t.tiles() * sizeof(uint32_t), gpu::MemoryUse::DeviceLocal);
+    t.tile_list = gpu::createBuffer(context, sizeof(shader::FibletListHeader) + t.tiles() * sizeof(uint32_t),
+                                    gpu::MemoryUse::DeviceLocal, VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
   } catch (...) {
     destroyFrameTargets(context, t);
     throw;
@@ -33,7 +41,18 @@ GpuFrameTargets createFrameTargets(const gpu::VulkanContext& context, uint32_t w
   return t;
 }
 
+uint64_t GpuFrameTargets::tiles() const { return uint64_t(shader::pixelGroups(width)) * shader::pixelGroups(height); }
+
+void ensureSurfaceTarget(const gpu::VulkanContext& context, GpuFrameTargets& targets) {
+  if (targets.surface.buffer) return;
+  targets.surface =
+      gpu::createBuffer(context, targets.pixels() * sizeof(shader::SurfaceTexel), gpu::MemoryUse::DeviceLocal);
+}
+
 void destroyFrameTargets(const gpu::VulkanContext& context, GpuFrameTargets& targets) {
+  gpu::destroyBuffer(context, targets.surface);
+  for (gpu::Buffer* b : {&targets.tile_list, &targets.tile_flags, &targets.shaded, &targets.ao_blur, &targets.ao})
+    gpu::destroyBuffer(context, *b);
   gpu::destroyBuffer(context, targets.tangents);
   gpu::destroyBuffer(context, targets.color);
   gpu::destroyBuffer(context, targets.gbuffer);
@@ -69,6 +88,13 @@ std::vector<uint8_t> downloadColor(const gpu::VulkanContext& context, const GpuF
 std::vector<shader::GBufferTexel> downloadGBuffer(const gpu::VulkanContext& context, const GpuFrameTargets& targets) {
   std::vector<shader::GBufferTexel> texels(targets.pixels());
   gpu::downloadFromBuffer(context, targets.gbuffer, texels.data(), texels.size() * sizeof(shader::GBufferTexel));
+  return texels;
+}
+
+std::vector<shader::SurfaceTexel> downloadSurface(const gpu::VulkanContext& context, const GpuFrameTargets& targets) {
+  if (!targets.surface.buffer) return {};
+  std::vector<shader::SurfaceTexel> texels(targets.pixels());
+  gpu::downloadFromBuffer(context, targets.surface, texels.data(), texels.size() * sizeof(shader::SurfaceTexel));
   return texels;
 }
 

@@ -25,13 +25,27 @@ struct GpuFrameTargets {
   // fiblet rasters draw, a uint at fiblet * 64 + segment, so the resolve
   // reads it instead of decoding the fiblet again per pixel (render_push.h).
   gpu::Buffer tangents;
+  // Shading scratch (gpu_shading_stages.h): occlusion per pixel (float; the
+  // ssao stage writes ao, its x blur ao_blur, its y blur ao again), the
+  // unfiltered shaded image FXAA reads (RGBA8), a flag per 8 x 8 tile and
+  // the covered tiles (shared/fiblet_list.h layout, an indirect dispatch).
+  gpu::Buffer ao, ao_blur, shaded, tile_flags, tile_list;
+  // The surface target (SurfaceTexel per pixel, shared/gbuffer.h): made by
+  // ensureSurfaceTarget at the first frame with surfaces.
+  gpu::Buffer surface;
   uint64_t pixels() const { return uint64_t(width) * height; }
+  // 8 x 8 tiles covering the frame.
+  uint64_t tiles() const;
 };
 
 // Buffers for a width x height frame. Throws Error for an empty size, a
 // size above 16384 px per side, or when memory runs out.
 GpuFrameTargets createFrameTargets(const gpu::VulkanContext& context, uint32_t width, uint32_t height);
 void destroyFrameTargets(const gpu::VulkanContext& context, GpuFrameTargets& targets);
+
+// Makes targets.surface when it does not exist yet. Throws Error when
+// memory runs out.
+void ensureSurfaceTarget(const gpu::VulkanContext& context, GpuFrameTargets& targets);
 
 // The tangent cache's budget: 256 bytes a fiblet (4 times its record) is
 // worth it below this, or a quarter of the device-local heap if smaller;
@@ -46,6 +60,8 @@ void prepareTangentCache(const gpu::VulkanContext& context, GpuFrameTargets& tar
 // Read-backs for tests and PNG output (wait for the queue).
 std::vector<uint8_t> downloadColor(const gpu::VulkanContext& context, const GpuFrameTargets& targets);
 std::vector<shader::GBufferTexel> downloadGBuffer(const gpu::VulkanContext& context, const GpuFrameTargets& targets);
+// Empty when the targets have no surface target.
+std::vector<shader::SurfaceTexel> downloadSurface(const gpu::VulkanContext& context, const GpuFrameTargets& targets);
 // The keys row by row (the buffer holds them in 4 x 2 blocks: visibilityIndex).
 std::vector<uint64_t> downloadVisibility(const gpu::VulkanContext& context, const GpuFrameTargets& targets);
 

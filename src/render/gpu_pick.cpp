@@ -45,6 +45,8 @@ PickResult decodePick(const shader::GBufferTexel& texel) {
   result.fiber = texel.fiber;
   result.segment = texel.segment;
   result.depth = texel.depth;
+  result.surface = (texel.segment & shader::kGBufferSurface) != 0;
+  if (result.surface) result.source = texel.segment & ~shader::kGBufferSurface;
   return result;
 }
 

@@ -25,6 +25,11 @@ struct PickResult {
   uint32_t fiber = 0;   // streamline index (valid when hit)
   uint32_t segment = 0; // the G-buffer's pipeline-specific segment index (gbuffer.h)
   float depth = 1.0f;   // clip depth z/w in [0, 1]; 1 when nothing is drawn
+  // A surface was picked (shared/gbuffer.h: kGBufferSurface): `fiber` is
+  // the surface's fiber or object id (a sphere's id), `source` who drew it
+  // (kSurfaceSource*).
+  bool surface = false;
+  uint32_t source = 0;
 };
 
 // Bytes a pick read-back buffer needs (one GBufferTexel).

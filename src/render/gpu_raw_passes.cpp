@@ -9,8 +9,10 @@ namespace fibscope {
 RawPasses createRawPasses(const gpu::VulkanContext& context) {
   RawPasses passes;
   try {
-    passes.raster = gpu::createComputePipeline(context, "raw_raster.comp", sizeof(shader::RawRasterPush));
-    passes.resolve = gpu::createComputePipeline(context, "raw_resolve.comp", sizeof(shader::RawResolvePush));
+    passes.raster = gpu::createComputePipeline(context, "raw_raster.comp", sizeof(shader::RawRasterPush),
+                                                 gpu::WorkgroupSize{shader::kRawRasterGroupSize});
+    passes.resolve = gpu::createComputePipeline(context, "raw_resolve.comp", sizeof(shader::RawResolvePush),
+                                                  gpu::WorkgroupSize{shader::kPixelGroupSize, shader::kPixelGroupSize});
   } catch (...) {
     destroyRawPasses(context, passes);
     throw;

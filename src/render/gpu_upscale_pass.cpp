@@ -10,7 +10,8 @@ namespace fibscope {
 
 UpscalePass createUpscalePass(const gpu::VulkanContext& context) {
   UpscalePass pass;
-  pass.pipeline = gpu::createComputePipeline(context, "upscale_color.comp", sizeof(shader::UpscalePush));
+  pass.pipeline = gpu::createComputePipeline(context, "upscale_color.comp", sizeof(shader::UpscalePush),
+                                             gpu::WorkgroupSize{shader::kPixelGroupSize, shader::kPixelGroupSize});
   return pass;
 }
 

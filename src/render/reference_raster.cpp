@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <glm/glm.hpp>
 #include <string>
 
 #include "core/error.h"
@@ -132,6 +133,52 @@ ReferenceFrame rasterizeReference(const Tractogram& tractogram, const Camera& ca
     }
   }
   return frame;
+}
+
+void rasterizeReferenceSpheres(ReferenceFrame& frame, const std::vector<ReferenceSphere>& spheres,
+                               const Camera& camera) {
+  const std::array<double, 16> vp = viewProjectionD(camera);  // validates the camera
+  const std::array<double, 16> view = viewMatrixD(camera), projection = projectionMatrixD(camera);
+  if (frame.width != camera.width || frame.height != camera.height)
+    fail("reference raster", "the frame is not the camera's size");
+  for (const ReferenceSphere& s : spheres)
+    if (!(s.radius > 0)) fail("reference raster", "a sphere's radius must be > 0 mm");
+  // The view's axes in world space are the rows of its rotation; the eye
+  // ray through NDC (x, y) is (x / P00, y / P11, -1) in view space.
+  const glm::dvec3 right(view[0], view[4], view[8]), up(view[1], view[5], view[9]), back(view[2], view[6], view[10]);
+  const glm::dvec3 eye(camera.eye[0], camera.eye[1], camera.eye[2]);
+  auto clipDepth = [&](const glm::dvec3& q) {
+    const double z = vp[2] * q.x + vp[6] * q.y + vp[10] * q.z + vp[14];
+    const double w = vp[3] * q.x + vp[7] * q.y + vp[11] * q.z + vp[15];
+    return w > 0 ? z / w : -1.0;
+  };
+  for (uint32_t py = 0; py < frame.height; ++py) {
+    for (uint32_t px = 0; px < frame.width; ++px) {
+      const double x_ndc = (px + 0.5) / frame.width * 2 - 1, y_ndc = (py + 0.5) / frame.height * 2 - 1;
+      const glm::dvec3 d = glm::normalize(x_ndc / projection[0] * right + y_ndc / projection[5] * up - back);
+      const size_t i = frame.index(px, py);
+      for (const ReferenceSphere& s : spheres) {
+        const glm::dvec3 c(s.center[0], s.center[1], s.center[2]);
+        const glm::dvec3 oc = eye - c;
+        const double b = glm::dot(oc, d);
+        const double disc = s.radius * s.radius - glm::dot(oc - b * d, oc - b * d);
+        if (disc < 0) continue;
+        double t = -b - std::sqrt(disc);
+        double depth = clipDepth(eye + t * d);
+        if (depth < 0) {
+          t = -b + std::sqrt(disc);
+          depth = clipDepth(eye + t * d);
+        }
+        if (!(depth >= 0 && depth <= 1) || !(depth < frame.depth[i])) continue;
+        const glm::dvec3 n = (eye + t * d - c) / s.radius;
+        frame.depth[i] = float(depth);
+        frame.fiber[i] = s.id;
+        frame.point[i] = 0;
+        frame.tangent[i] = {float(n.x), float(n.y), float(n.z)};
+        ++frame.fragments[i];
+      }
+    }
+  }
 }
 
 std::vector<uint8_t> shadeOrientation(const ReferenceFrame& frame) {

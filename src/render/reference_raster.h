@@ -85,6 +85,24 @@ void rasterizeWindowSegment(ReferenceFrame& frame, const WindowVertex& a, const 
 ReferenceFrame rasterizeReference(const Tractogram& tractogram, const Camera& camera,
                                   float line_width_px = 1.0f);
 
+// A sphere drawn with the lines: the CPU reference of the surface passes
+// (shaders/sphere_surface.comp and the merge, shared/surface_push.h).
+struct ReferenceSphere {
+  std::array<double, 3> center = {0, 0, 0};  // world mm
+  double radius = 1;                         // mm, > 0
+  uint32_t id = 0;                           // written to the pixels it wins, as their fiber
+};
+
+// For every pixel, the eye ray through its centre (in double precision,
+// from the camera's matrices) against every sphere: the nearer root, or the
+// farther one where the nearer lies before the near plane; the hit's clip
+// depth from viewProjectionD. A hit with depth in [0, 1] strictly nearer
+// than what the frame holds (lines or an earlier sphere) wins the pixel:
+// fiber = the sphere's id, point = 0, tangent = the outward unit normal.
+// Throws Error for an invalid camera or a sphere whose radius is not > 0.
+void rasterizeReferenceSpheres(ReferenceFrame& frame, const std::vector<ReferenceSphere>& spheres,
+                               const Camera& camera);
+
 // Orientation colour: |tangent| as RGB on a black background, alpha 255;
 // row-major RGBA8, top row first.
 std::vector<uint8_t> shadeOrientation(const ReferenceFrame& frame);

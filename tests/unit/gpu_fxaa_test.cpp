@@ -10,7 +10,7 @@
 
 #include "gpu/submit.h"
 #include "gpu_test_context.h"
-#include "render/gpu_shade_pass.h"
+#include "render/gpu_shading_stages.h"
 
 namespace fibscope {
 namespace {
@@ -20,7 +20,7 @@ constexpr uint32_t kSize = 64;
 class GpuFxaa : public test::GpuTest {
  protected:
   std::vector<uint32_t> fxaa(const std::vector<uint32_t>& image) {
-    ShadePass pass = createShadePass(context(), kSize, kSize);
+    FxaaPass pass = createFxaaPass(context());
     gpu::Buffer in, out;
     std::vector<uint32_t> result(image.size());
     try {
@@ -32,12 +32,12 @@ class GpuFxaa : public test::GpuTest {
     } catch (...) {
       gpu::destroyBuffer(context(), in);
       gpu::destroyBuffer(context(), out);
-      destroyShadePass(context(), pass);
+      destroyFxaaPass(context(), pass);
       throw;
     }
     gpu::destroyBuffer(context(), in);
     gpu::destroyBuffer(context(), out);
-    destroyShadePass(context(), pass);
+    destroyFxaaPass(context(), pass);
     return result;
   }
 };

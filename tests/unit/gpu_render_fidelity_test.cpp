@@ -20,6 +20,7 @@
 #include "io/reader.h"
 #include "phantom/phantom.h"
 #include "render/camera.h"
+#include "render/gpu_fiblet_passes.h"
 #include "render/gpu_frame_renderer.h"
 #include "render/gpu_scene_table.h"
 #include "render/gpu_tractogram_upload.h"

@@ -1,4 +1,4 @@
-// The shading passes (src/render/gpu_shade_pass.h) on hand-made G-buffers,
+// The shading stages (src/render/gpu_shading_stages.h) on hand-made G-buffers,
 // checked against CPU computations of the same formulas written
 // independently of the shaders (world position from the inverse of the
 // double-precision view-projection, light from the camera's look-at frame),
@@ -23,7 +23,8 @@
 #include "render/colormap.h"
 #include "render/gpu_fiber_attributes.h"
 #include "render/gpu_frame_renderer.h"
-#include "render/gpu_shade_pass.h"
+#include "gpu_given_gbuffer_stage.h"
+#include "render/gpu_shading_stages.h"
 #include "render/gpu_tractogram_upload.h"
 #include "render/reference_raster.h"
 #include "shared/gbuffer.h"
@@ -201,6 +202,14 @@ Rgb expectedColor(const Camera& camera, const RenderSettings& s, const Texel& t,
   return c;
 }
 
+// What the shaded fibers' attributes are (GpuScene's) and how many fibers
+// they cover.
+struct ShadeFiberInputs {
+  VkDeviceAddress fiber_scalars = 0;
+  VkDeviceAddress selection_bits = 0;
+  uint32_t fiber_count = 0;
+};
+
 class GpuShade : public test::GpuTest {
  protected:
   static constexpr uint32_t kSize = 32;
@@ -224,35 +233,24 @@ class GpuShade : public test::GpuTest {
     return shadeGBuffer(camera(), gbuffer, settings, fibers);
   }
 
-  // Shades `gbuffer` (camera.width x camera.height texels) and returns
-  // RGBA8; with `tile_list`, also the shade pass's tile list as the words
-  // of its buffer (header, then one index per tile at most).
+  // Shades `gbuffer` (camera.width x camera.height texels) through the
+  // shading stages of a FrameRenderer and returns RGBA8; with `tile_list`,
+  // also the tiles stage's list as the words of its buffer (header, then
+  // one index per tile at most).
   std::vector<uint8_t> shadeGBuffer(const Camera& cam, const std::vector<shader::GBufferTexel>& gbuffer,
                                     const RenderSettings& settings, const ShadeFiberInputs& fibers = {},
                                     std::vector<uint32_t>* tile_list = nullptr) {
-    const uint32_t w = cam.width, h = cam.height;
-    GpuFrameTargets frame = createFrameTargets(context(), w, h);
-    ShadePass pass{};
-    std::vector<uint8_t> rgba;
-    try {
-      pass = createShadePass(context(), w, h);
-      const shader::CameraBlock block = makeCameraBlock(cam, 1.0f);
-      gpu::uploadToBuffer(context(), frame.camera, &block, sizeof(block));
-      gpu::uploadToBuffer(context(), frame.gbuffer, gbuffer.data(), gbuffer.size() * sizeof(gbuffer[0]));
-      gpu::submitOnce(context(), [&](VkCommandBuffer cmd) { recordShade(cmd, pass, frame, settings, nullptr, fibers); });
-      rgba = downloadColor(context(), frame);
-      if (tile_list) {
-        tile_list->resize(pass.tile_list.size / sizeof(uint32_t));
-        gpu::downloadFromBuffer(context(), pass.tile_list, tile_list->data(), pass.tile_list.size);
-      }
-    } catch (...) {
-      destroyShadePass(context(), pass);
-      destroyFrameTargets(context(), frame);
-      throw;
+    FrameRenderer renderer(context(), cam.width, cam.height, test::givenGBufferStages(gbuffer, fibers.fiber_count));
+    GpuScene scene;
+    scene.fiber_scalars = fibers.fiber_scalars;
+    scene.selection_bits = fibers.selection_bits;
+    renderer.render(cam, settings, scene);
+    if (tile_list) {
+      const gpu::Buffer& list = renderer.targets().tile_list;
+      tile_list->resize(list.size / sizeof(uint32_t));
+      gpu::downloadFromBuffer(context(), list, tile_list->data(), list.size);
     }
-    destroyShadePass(context(), pass);
-    destroyFrameTargets(context(), frame);
-    return rgba;
+    return downloadColor(context(), renderer.targets());
   }
 
   static std::array<uint8_t, 4> pixel(const std::vector<uint8_t>& rgba, uint32_t x, uint32_t y) {

@@ -79,14 +79,11 @@ using ViewerAction = std::variant<OrbitAction, PanAction, DollyAction, ViewActio
                                   ExportSelectionAction, ExpectSelectedAction, ResizeAction, QuitAction>;
 
 // Sets one RenderSettings field from text, as `set KEY VALUE` in a script:
-//   pipeline compute|lines|raw-compute, culling none|frustum|two-phase,
-//   color orientation|solid|fiber|scalar|normal, colormap viridis|magma|
-//   grayscale|coolwarm, scalar-range MIN,MAX, lighting illuminated|none,
-//   width 1..4 (px), ssao on|off, ssao-radius 1..64 (px), ssao-strength
-//   0..1, ao-scales 1..4, fxaa on|off, background R,G,B and highlight R,G,B
-//   (each in [0, 1]), dim 0..1 (unselected fibers towards the background).
-// Throws Error (one line) naming the key and what was expected; leaves
-// `settings` unchanged then. Safe on untrusted text.
+// KEY is a setting's name in render/settings_table.h (the command line's
+// --KEY without the dashes; `width` still names line-width), VALUE as on the
+// command line, `on`/`off` for flags. Throws Error (one line) naming the
+// key and what was expected; leaves `settings` unchanged then. Safe on
+// untrusted text.
 void applySetting(RenderSettings& settings, std::string_view key, std::string_view value);
 
 // "sagittal" -> Sagittal ...; "reset" -> a ViewAction without a view.

@@ -7,26 +7,52 @@
 #include <cstdio>
 #include <string>
 
+#include "render/settings_table.h"
+
 namespace fibscope {
 namespace {
 
-// A combo over an enum whose values are 0..count-1 with names from `name`.
-template <typename Enum, typename NameFn>
-bool enumCombo(const char* label, Enum& value, int count, NameFn name) {
-  bool changed = false;
-  const std::string current(name(value));
-  if (ImGui::BeginCombo(label, current.c_str())) {
-    for (int i = 0; i < count; ++i) {
-      const Enum option = Enum(i);
-      const std::string text(name(option));
-      if (ImGui::Selectable(text.c_str(), option == value)) {
-        changed = option != value;
-        value = option;
-      }
+// The panel's widget of one setting of render/settings_table.h: its label,
+// its range (sliders clamp to it), its help as the tooltip.
+void settingWidget(RenderSettings& s, const SettingInfo& info) {
+  const std::string label(info.label);
+  const std::string unit = info.unit.empty() ? "" : " " + std::string(info.unit);
+  // Wide ranges (LoD in px, the scalar range) read better on a log scale.
+  const ImGuiSliderFlags flags =
+      ImGuiSliderFlags_AlwaysClamp | (info.max - info.min > 200 ? ImGuiSliderFlags_Logarithmic : 0);
+  switch (info.kind) {
+    case SettingKind::Flag: ImGui::Checkbox(label.c_str(), &(s.*info.flag)); break;
+    case SettingKind::Integer:
+      ImGui::SliderInt(label.c_str(), &(s.*info.integer), int(info.min), int(info.max), "%d", flags);
+      break;
+    case SettingKind::Number: {
+      const std::string format = (info.max - info.min > 20 ? "%.1f" : "%.2f") + unit;
+      ImGui::SliderFloat(label.c_str(), &(s.*info.number), float(info.min), float(info.max), format.c_str(), flags);
+      break;
     }
-    ImGui::EndCombo();
+    case SettingKind::Choice: {
+      const int current = info.get_choice(s);
+      const std::string name(info.choice_name(current));
+      if (ImGui::BeginCombo(label.c_str(), name.c_str())) {
+        for (int i = 0; i < info.choice_count; ++i) {
+          const std::string option(info.choice_name(i));
+          if (ImGui::Selectable(option.c_str(), i == current)) info.set_choice(s, i);
+        }
+        ImGui::EndCombo();
+      }
+      break;
+    }
+    case SettingKind::Color: ImGui::ColorEdit3(label.c_str(), (s.*info.color).data()); break;
+    case SettingKind::Range: {
+      float& lo = s.*info.number;
+      float& hi = s.*info.number_max;
+      ImGui::DragFloatRange2(label.c_str(), &lo, &hi, 0.5f, float(info.min), float(info.max), "%.1f", "%.1f",
+                             ImGuiSliderFlags_AlwaysClamp);
+      if (hi < lo) hi = lo;
+      break;
+    }
   }
-  return changed;
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", std::string(info.help).c_str());
 }
 
 void settingsPanel(ViewerState& state, std::vector<ViewerAction>& actions) {
@@ -37,22 +63,14 @@ void settingsPanel(ViewerState& state, std::vector<ViewerAction>& actions) {
     return;
   }
   RenderSettings& s = state.settings;
-  enumCombo("pipeline", s.pipeline, 3, renderPipelineName);
-  if (state.baseline_draws_active_only)
-    ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "%s draws the active model only",
-                       std::string(renderPipelineName(s.pipeline)).c_str());
-  if (s.pipeline == RenderPipeline::Compute) enumCombo("culling", s.culling, 3, cullingModeName);
-  if (s.pipeline == RenderPipeline::Compute && s.culling != CullingMode::None)
-    ImGui::SliderFloat("LoD below", &s.lod_pixels, 0.0f, 16.0f, "%.1f px");
-  ImGui::SliderFloat("line width", &s.line_width_px, 1.0f, 4.0f, "%.1f px");
-  enumCombo("colour", s.color, 5, colorModeName);
-  if (s.color == ColorMode::Solid) ImGui::ColorEdit3("solid colour", s.solid_color.data());
-  if (s.color == ColorMode::Scalar) {
-    ImGui::TextDisabled("scalar: fiber length (mm)");
-    enumCombo("colormap", s.colormap, 4, colormapName);
-    ImGui::DragFloatRange2("range", &s.scalar_min, &s.scalar_max, 0.5f, 0.0f, 0.0f, "%.1f", "%.1f");
-    if (s.scalar_max < s.scalar_min) s.scalar_max = s.scalar_min;
-    if (state.scalar_data_min <= state.scalar_data_max) {
+  for (const SettingInfo& info : renderSettingsTable()) {
+    if (info.relevant && !info.relevant(s)) continue;
+    if (info.name == "colormap") ImGui::TextDisabled("scalar: fiber length (mm)");
+    settingWidget(s, info);
+    if (info.name == "pipeline" && state.baseline_draws_active_only)
+      ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "%s draws the active model only",
+                         std::string(renderPipelineName(s.pipeline)).c_str());
+    if (info.name == "scalar-range" && state.scalar_data_min <= state.scalar_data_max) {
       ImGui::SameLine();
       if (ImGui::SmallButton("fit")) {
         s.scalar_min = state.scalar_data_min;
@@ -60,29 +78,11 @@ void settingsPanel(ViewerState& state, std::vector<ViewerAction>& actions) {
       }
     }
   }
-  enumCombo("lighting", s.lighting, 2, lightingName);
-  if (s.lighting == Lighting::IlluminatedLines && ImGui::TreeNode("light")) {
-    ImGui::SliderFloat("ambient", &s.light_ambient, 0.0f, 1.0f, "%.2f");
-    ImGui::SliderFloat("diffuse", &s.light_diffuse, 0.0f, 1.0f, "%.2f");
-    ImGui::SliderFloat("specular", &s.light_specular, 0.0f, 1.0f, "%.2f");
-    ImGui::SliderFloat("shininess", &s.light_shininess, 1.0f, 128.0f, "%.0f");
-    ImGui::TreePop();
-  }
-  ImGui::Checkbox("ambient occlusion", &s.ssao);
-  if (s.ssao) {
-    ImGui::SliderFloat("AO radius", &s.ssao_radius_px, 1.0f, 40.0f, "%.0f px");
-    ImGui::SliderFloat("AO strength", &s.ssao_strength, 0.0f, 1.0f, "%.2f");
-    ImGui::SliderInt("AO scales", &s.ao_scales, 1, 4);
-    if (ImGui::IsItemHovered()) ImGui::SetTooltip("multi-scale AO: radii r, 2r, 4r, 8r combined");
-    ImGui::SliderFloat("AO range", &s.ssao_range_mm, 1.0f, 40.0f, "%.0f mm");
-  }
-  ImGui::Checkbox("FXAA", &s.fxaa);
   ImGui::Checkbox("coarse while moving", &state.adaptive_detail);
   if (ImGui::IsItemHovered())
     ImGui::SetTooltip("where a full frame takes over 100 ms: moves drawn with fiblets under the LoD size as one "
                       "segment; full detail when the camera stops");
   if (state.adaptive_detail) ImGui::SliderFloat("moving LoD", &state.moving_lod_px, 4.0f, 512.0f, "%.0f px");
-  ImGui::ColorEdit3("background", s.background.data());
   float fov = float(state.fov_deg);
   if (ImGui::SliderFloat("field of view", &fov, 10.0f, 90.0f, "%.0f deg")) actions.push_back(FovAction{fov});
 

@@ -1,0 +1,317 @@
+#include "render/settings_table.h"
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "core/error.h"
+#include "render/colormap.h"
+#include "render/reference_raster.h"
+#include "shared/shade_push.h"
+
+namespace fibscope {
+namespace {
+
+// Choice accessors for an enum member.
+template <typename Enum, Enum RenderSettings::*member>
+int getChoice(const RenderSettings& s) {
+  return int(s.*member);
+}
+template <typename Enum, Enum RenderSettings::*member>
+void setChoice(RenderSettings& s, int v) {
+  s.*member = Enum(v);
+}
+
+SettingInfo choice(std::string_view name, std::string_view label, std::string_view help, int count,
+                   std::string_view (*name_of)(int), int (*get)(const RenderSettings&),
+                   void (*set)(RenderSettings&, int)) {
+  SettingInfo i;
+  i.name = name;
+  i.label = label;
+  i.help = help;
+  i.kind = SettingKind::Choice;
+  i.choice_count = count;
+  i.choice_name = name_of;
+  i.get_choice = get;
+  i.set_choice = set;
+  return i;
+}
+
+SettingInfo number(std::string_view name, std::string_view label, std::string_view help, float RenderSettings::*m,
+                   double lo, double hi, std::string_view unit = {}) {
+  SettingInfo i;
+  i.name = name;
+  i.label = label;
+  i.help = help;
+  i.kind = SettingKind::Number;
+  i.number = m;
+  i.min = lo;
+  i.max = hi;
+  i.unit = unit;
+  return i;
+}
+
+SettingInfo flag(std::string_view name, std::string_view label, std::string_view help, bool RenderSettings::*m) {
+  SettingInfo i;
+  i.name = name;
+  i.label = label;
+  i.help = help;
+  i.kind = SettingKind::Flag;
+  i.flag = m;
+  return i;
+}
+
+SettingInfo color(std::string_view name, std::string_view label, std::string_view help,
+                  std::array<float, 3> RenderSettings::*m) {
+  SettingInfo i;
+  i.name = name;
+  i.label = label;
+  i.help = help;
+  i.kind = SettingKind::Color;
+  i.color = m;
+  i.min = 0;
+  i.max = 1;
+  return i;
+}
+
+template <typename T>
+T&& with(T&& info, bool (*relevant)(const RenderSettings&)) {
+  info.relevant = relevant;
+  return std::forward<T>(info);
+}
+
+bool isCompute(const RenderSettings& s) { return s.pipeline == RenderPipeline::Compute; }
+bool isCulled(const RenderSettings& s) { return isCompute(s) && s.culling != CullingMode::None; }
+bool isSolid(const RenderSettings& s) { return s.color == ColorMode::Solid; }
+bool isScalar(const RenderSettings& s) { return s.color == ColorMode::Scalar; }
+bool isLit(const RenderSettings& s) { return s.lighting == Lighting::IlluminatedLines; }
+bool hasSsao(const RenderSettings& s) { return s.ssao; }
+
+std::vector<SettingInfo> makeTable() {
+  std::vector<SettingInfo> t;
+  t.push_back(choice("pipeline", "pipeline", "compute | lines | raw-compute", 3,
+                     [](int v) { return renderPipelineName(RenderPipeline(v)); },
+                     getChoice<RenderPipeline, &RenderSettings::pipeline>,
+                     setChoice<RenderPipeline, &RenderSettings::pipeline>));
+  t.push_back(with(choice("culling", "culling", "none | frustum | two-phase (compute pipeline)", 3,
+                          [](int v) { return cullingModeName(CullingMode(v)); },
+                          getChoice<CullingMode, &RenderSettings::culling>,
+                          setChoice<CullingMode, &RenderSettings::culling>),
+                   isCompute));
+  t.push_back(with(number("lod-pixels", "LoD below",
+                          "Far-view LoD: fiblets whose bounding sphere projects smaller are drawn as one segment "
+                          "(frustum and two-phase culling; 0: off)",
+                          &RenderSettings::lod_pixels, 0, 4096, "px"),
+                   isCulled));
+  SettingInfo width = number("line-width", "line width", "Line width in pixels", &RenderSettings::line_width_px,
+                             kMinLineWidth, kMaxLineWidth, "px");
+  width.alias = "width";
+  t.push_back(width);
+  t.push_back(choice("color", "colour", "orientation | solid | fiber | scalar (fiber length) | normal", 5,
+                     [](int v) { return colorModeName(ColorMode(v)); }, getChoice<ColorMode, &RenderSettings::color>,
+                     setChoice<ColorMode, &RenderSettings::color>));
+  t.push_back(with(color("solid-color", "solid colour", "The solid colour R,G,B in [0, 1] (--color solid)",
+                         &RenderSettings::solid_color),
+                   isSolid));
+  t.push_back(with(choice("colormap", "colormap", "viridis | magma | grayscale | coolwarm (--color scalar)", 4,
+                          [](int v) { return colormapName(Colormap(v)); },
+                          getChoice<Colormap, &RenderSettings::colormap>,
+                          setChoice<Colormap, &RenderSettings::colormap>),
+                   isScalar));
+  SettingInfo range;
+  range.name = "scalar-range";
+  range.label = "range";
+  range.help = "MIN,MAX mapped onto the colormap (default: the data's range)";
+  range.kind = SettingKind::Range;
+  range.number = &RenderSettings::scalar_min;
+  range.number_max = &RenderSettings::scalar_max;
+  range.min = -1e30;
+  range.max = 1e30;
+  range.relevant = isScalar;
+  t.push_back(range);
+  t.push_back(color("highlight", "highlight", "Colour of selected fibers R,G,B in [0, 1]",
+                    &RenderSettings::highlight_color));
+  t.push_back(number("dim", "dim unselected",
+                     "How far unselected fibers fade towards the background when there is a selection (0: not, "
+                     "1: invisible)",
+                     &RenderSettings::dim_unselected, 0, 1));
+  t.push_back(choice("lighting", "lighting", "illuminated | none", 2,
+                     [](int v) { return lightingName(Lighting(v)); }, getChoice<Lighting, &RenderSettings::lighting>,
+                     setChoice<Lighting, &RenderSettings::lighting>));
+  t.push_back(with(number("ambient", "ambient", "Ambient light coefficient", &RenderSettings::light_ambient, 0, 4),
+                   isLit));
+  t.push_back(with(number("diffuse", "diffuse", "Diffuse light coefficient", &RenderSettings::light_diffuse, 0, 4),
+                   isLit));
+  t.push_back(
+      with(number("specular", "specular", "Specular light coefficient", &RenderSettings::light_specular, 0, 4),
+           isLit));
+  t.push_back(with(number("shininess", "shininess", "Specular exponent", &RenderSettings::light_shininess, 1, 256),
+                   isLit));
+  t.push_back(flag("ssao", "ambient occlusion", "Screen-space ambient occlusion", &RenderSettings::ssao));
+  t.push_back(with(number("ssao-radius", "AO radius", "SSAO sampling radius in pixels (the smallest scale)",
+                          &RenderSettings::ssao_radius_px, 1, 64, "px"),
+                   hasSsao));
+  t.push_back(with(number("ssao-strength", "AO strength", "How dark full occlusion gets (0 to 1)",
+                          &RenderSettings::ssao_strength, 0, 1),
+                   hasSsao));
+  SettingInfo scales;
+  scales.name = "ao-scales";
+  scales.label = "AO scales";
+  scales.help = "Multi-scale AO: 1 to 4 radii (r, 2r, 4r, 8r)";
+  scales.kind = SettingKind::Integer;
+  scales.integer = &RenderSettings::ao_scales;
+  scales.min = 1;
+  scales.max = shader::kSsaoMaxScales;
+  scales.relevant = hasSsao;
+  t.push_back(scales);
+  t.push_back(with(number("ssao-range", "AO range",
+                          "Neighbours nearer than this (view distance) no longer occlude, in mm",
+                          &RenderSettings::ssao_range_mm, 0.5, 200, "mm"),
+                   hasSsao));
+  t.push_back(flag("fxaa", "FXAA", "Fast approximate anti-aliasing of the image", &RenderSettings::fxaa));
+  t.push_back(color("background", "background", "Background colour R,G,B in [0, 1]", &RenderSettings::background));
+  return t;
+}
+
+bool parseDouble(std::string_view text, double& out) {
+  const char* end = text.data() + text.size();
+  auto [p, ec] = std::from_chars(text.data(), end, out);
+  return ec == std::errc() && p == end && std::isfinite(out);
+}
+
+// "A,B[,C]": exactly `n` finite numbers.
+bool parseList(std::string_view text, double* out, int n) {
+  for (int k = 0; k < n; ++k) {
+    const size_t comma = k + 1 < n ? text.find(',') : std::string_view::npos;
+    if (k + 1 < n && comma == std::string_view::npos) return false;
+    if (!parseDouble(text.substr(0, comma), out[k])) return false;
+    text = comma == std::string_view::npos ? std::string_view{} : text.substr(comma + 1);
+  }
+  return true;
+}
+
+std::string number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+std::string withUnit(const SettingInfo& info, double lo, double hi) {
+  return number(lo) + " to " + number(hi) + (info.unit.empty() ? "" : " " + std::string(info.unit));
+}
+
+bool inRange(const SettingInfo& info, double v) { return v >= info.min && v <= info.max; }  // false for NaN
+
+}  // namespace
+
+std::span<const SettingInfo> renderSettingsTable() {
+  static const std::vector<SettingInfo> table = makeTable();
+  return table;
+}
+
+const SettingInfo* findSetting(std::string_view name) {
+  for (const SettingInfo& s : renderSettingsTable())
+    if (s.name == name || (!s.alias.empty() && s.alias == name)) return &s;
+  return nullptr;
+}
+
+std::string settingExpectation(const SettingInfo& info) {
+  switch (info.kind) {
+    case SettingKind::Flag: return "on or off";
+    case SettingKind::Integer:
+    case SettingKind::Number: return withUnit(info, info.min, info.max);
+    case SettingKind::Choice: {
+      std::string names;
+      for (int i = 0; i < info.choice_count; ++i) names += (i ? ", " : "") + std::string(info.choice_name(i));
+      return "one of: " + names;
+    }
+    case SettingKind::Color: return "R,G,B with each in [0, 1]";
+    case SettingKind::Range: return "MIN,MAX (finite, MIN <= MAX)";
+  }
+  return {};
+}
+
+void setSetting(RenderSettings& s, const SettingInfo& info, std::string_view text, std::string_view where) {
+  auto bad = [&]() -> Error {
+    return Error(std::string(where) + ": expected " + settingExpectation(info) + ", got '" + std::string(text) + "'");
+  };
+  switch (info.kind) {
+    case SettingKind::Flag:
+      if (text != "on" && text != "off") throw bad();
+      s.*info.flag = text == "on";
+      return;
+    case SettingKind::Integer: {
+      double v = 0;
+      if (!parseDouble(text, v) || v != std::floor(v) || !inRange(info, v)) throw bad();
+      s.*info.integer = int(v);
+      return;
+    }
+    case SettingKind::Number: {
+      double v = 0;
+      if (!parseDouble(text, v) || !inRange(info, v)) throw bad();
+      s.*info.number = float(v);
+      return;
+    }
+    case SettingKind::Choice:
+      for (int i = 0; i < info.choice_count; ++i)
+        if (info.choice_name(i) == text) {
+          info.set_choice(s, i);
+          return;
+        }
+      throw bad();
+    case SettingKind::Color: {
+      double c[3];
+      if (!parseList(text, c, 3)) throw bad();
+      for (double v : c)
+        if (!(v >= 0 && v <= 1)) throw bad();
+      s.*info.color = {float(c[0]), float(c[1]), float(c[2])};
+      return;
+    }
+    case SettingKind::Range: {
+      double r[2];
+      if (!parseList(text, r, 2) || !(r[0] <= r[1]) || !inRange(info, r[0]) || !inRange(info, r[1])) throw bad();
+      s.*info.number = float(r[0]);
+      s.*info.number_max = float(r[1]);
+      return;
+    }
+  }
+}
+
+std::string settingText(const RenderSettings& s, const SettingInfo& info) {
+  switch (info.kind) {
+    case SettingKind::Flag: return s.*info.flag ? "on" : "off";
+    case SettingKind::Integer: return std::to_string(s.*info.integer);
+    case SettingKind::Number: return number(s.*info.number);
+    case SettingKind::Choice: return std::string(info.choice_name(info.get_choice(s)));
+    case SettingKind::Color: {
+      const std::array<float, 3>& c = s.*info.color;
+      return number(c[0]) + "," + number(c[1]) + "," + number(c[2]);
+    }
+    case SettingKind::Range: return number(s.*info.number) + "," + number(s.*info.number_max);
+  }
+  return {};
+}
+
+void validateRenderSettings(const RenderSettings& s) {
+  for (const SettingInfo& info : renderSettingsTable()) {
+    bool ok = true;
+    switch (info.kind) {
+      case SettingKind::Flag: break;
+      case SettingKind::Integer: ok = inRange(info, s.*info.integer); break;
+      case SettingKind::Number: ok = inRange(info, s.*info.number); break;
+      case SettingKind::Choice: ok = info.get_choice(s) >= 0 && info.get_choice(s) < info.choice_count; break;
+      case SettingKind::Color:
+        for (float v : s.*info.color) ok &= v >= 0.0f && v <= 1.0f;
+        break;
+      case SettingKind::Range:
+        ok = inRange(info, s.*info.number) && inRange(info, s.*info.number_max) && s.*info.number <= s.*info.number_max;
+        break;
+    }
+    if (!ok)
+      throw Error("render: " + std::string(info.label) + " must be " + settingExpectation(info) + ", got " +
+                  (info.kind == SettingKind::Choice ? std::to_string(info.get_choice(s)) : settingText(s, info)));
+  }
+}
+
+}  // namespace fibscope

@@ -1,0 +1,53 @@
+// A frame stage for tests of the stages after the geometry: it copies a
+// G-buffer made on the host into the frame's (in place of the pipelines'
+// geometry stages) and says how many fibers the per-fiber attributes cover.
+// With it a test runs the real shading stages through FrameRenderer on
+// hand-made texels:
+//   FrameRenderer r(context, w, h, givenGBufferStages(texels, fibers));
+#pragma once
+
+#include <vector>
+
+#include "gpu/buffer.h"
+#include "gpu/pass_scope.h"
+#include "render/gpu_frame_stage.h"
+#include "render/gpu_frame_stages.h"
+#include "shared/gbuffer.h"
+
+namespace fibscope::test {
+
+class GivenGBufferStage final : public FrameStage {
+ public:
+  GivenGBufferStage(const gpu::VulkanContext& context, const std::vector<shader::GBufferTexel>& texels,
+                    uint32_t fiber_count)
+      : fiber_count_(fiber_count) {
+    staging_ = gpu::createBuffer(context, texels.size() * sizeof(texels[0]), gpu::MemoryUse::DeviceLocal);
+    gpu::uploadToBuffer(context, staging_, texels.data(), texels.size() * sizeof(texels[0]));
+  }
+  void destroy(const gpu::VulkanContext& context) override { gpu::destroyBuffer(context, staging_); }
+  uint32_t maxPasses() const override { return 1; }
+  bool runs(const FrameContext&) const override { return true; }
+  void record(FrameContext& frame) override {
+    frame.fiber_count = fiber_count_;
+    gpu::PassScope pass(frame.cmd, frame.timer, "given g-buffer",
+                        {VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                         VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, gpu::kStorageReadWrite});
+    const VkBufferCopy region{0, 0, staging_.size};
+    vkCmdCopyBuffer(frame.cmd, staging_.buffer, frame.targets.gbuffer.buffer, 1, &region);
+  }
+
+ private:
+  gpu::Buffer staging_;
+  uint32_t fiber_count_;
+};
+
+// setup, the given G-buffer, then the standard shading stages.
+inline FrameStageList givenGBufferStages(const std::vector<shader::GBufferTexel>& texels, uint32_t fiber_count) {
+  FrameStageList list = {makeSetupStage, [texels, fiber_count](const gpu::VulkanContext& context) {
+                           return std::make_unique<GivenGBufferStage>(context, texels, fiber_count);
+                         }};
+  for (FrameStageFactory& f : shadingStages()) list.push_back(std::move(f));
+  return list;
+}
+
+}  // namespace fibscope::test
