@@ -38,9 +38,9 @@ void offsetCrossSection(std::vector<Vec3>& controls, const double* radius, doubl
   std::array<Vec3, 16> moved;
   for (size_t j = 0; j < n; ++j) {
     const Vec3 ahead = controls[j + 1 < n ? j + 1 : j], behind = controls[j > 0 ? j - 1 : j];
-    const Vec3 t = normalized(ahead - behind);
-    const Vec3 nrm = normalized(cross(t, reference));
-    const Vec3 bin = cross(t, nrm);
+    const Vec3 t = glm::normalize(ahead - behind);
+    const Vec3 nrm = glm::normalize(glm::cross(t, reference));
+    const Vec3 bin = glm::cross(t, nrm);
     moved[j] = controls[j] + radius[j] * (u * nrm + v * bin);
   }
   for (size_t j = 0; j < n; ++j) controls[j] = moved[j];
@@ -65,7 +65,7 @@ void corpusCallosum(Rng& rng, std::vector<Vec3>& q) {
     const double phi = radians(elevation + rng.uniform(-6.0, 6.0));  // homotopic, not mirror-exact
     const Vec3 over_ventricle = {s * 14.0, y0 + 2.0 * forward, zc + dz + 3.0};
     const Vec3 origin = {s * 16.0, y0 + 5.0 * forward, zc + 0.5 * dz + 4.0};
-    const Vec3 direction = normalized({s * std::cos(phi), forward, std::sin(phi)});
+    const Vec3 direction = glm::normalize(Vec3{s * std::cos(phi), forward, std::sin(phi)});
     const Vec3 end = shellPoint(origin, direction, corticalDepth(rng));
     side_points[side][0] = over_ventricle;
     side_points[side][1] = lerp(origin, end, 0.45);
@@ -83,7 +83,7 @@ void corticospinal(Rng& rng, double s, std::vector<Vec3>& q) {
   const double fan = rng.uniform();
   const double psi = radians(lerp(82.0, 22.0, fan) + rng.uniform(-4.0, 4.0));
   const Vec3 origin = {s * (12.0 + 10.0 * fan), -18.0, 24.0};
-  const Vec3 end = shellPoint(origin, normalized({s * std::cos(psi), -0.15, std::sin(psi)}), corticalDepth(rng));
+  const Vec3 end = shellPoint(origin, glm::normalize(Vec3{s * std::cos(psi), -0.15, std::sin(psi)}), corticalDepth(rng));
   q = {Vec3{s * 7.0, -24.0, -53.0}, Vec3{s * 11.0, -20.0, -32.0}, Vec3{s * 20.0, -14.0, -6.0},
        Vec3{s * 21.0, -15.0, 8.0}, Vec3{s * (17.0 + 15.0 * fan), -16.0, 26.0 - 4.0 * fan}, end};
   static constexpr double kRadius[] = {2.0, 2.5, 3.0, 3.5, 4.0, 3.0};
@@ -99,9 +99,9 @@ void corticospinal(Rng& rng, double s, std::vector<Vec3>& q) {
 void arcuate(Rng& rng, double s, std::vector<Vec3>& q) {
   const double frontal = rng.uniform(), temporal = rng.uniform();
   const Vec3 front_origin = {s * 34.0, 10.0 + 14.0 * frontal, 16.0 + 8.0 * (frontal - 0.5)};
-  const Vec3 front_end = shellPoint(front_origin, normalized({s * 1.0, 0.35 + 0.3 * frontal, 0.05}), corticalDepth(rng));
+  const Vec3 front_end = shellPoint(front_origin, glm::normalize(Vec3{s * 1.0, 0.35 + 0.3 * frontal, 0.05}), corticalDepth(rng));
   const Vec3 temporal_origin = {s * 44.0, -14.0 + 14.0 * temporal, -16.0};
-  const Vec3 temporal_end = shellPoint(temporal_origin, normalized({s * 1.0, 0.25, -0.35}), corticalDepth(rng));
+  const Vec3 temporal_end = shellPoint(temporal_origin, glm::normalize(Vec3{s * 1.0, 0.25, -0.35}), corticalDepth(rng));
   q = {front_end,
        Vec3{s * 36.0, 2.0 + 6.0 * frontal, 24.0},
        Vec3{s * 37.0, -20.0, 27.0},
@@ -133,10 +133,10 @@ void cingulum(Rng& rng, double s, std::vector<Vec3>& q) {
 // inferior and orbital frontal cortex.
 void ifof(Rng& rng, double s, std::vector<Vec3>& q) {
   const double occipital = rng.uniform(), frontal = rng.uniform();
-  const Vec3 back = shellPoint({s * 26.0, -58.0, 4.0 + 12.0 * (occipital - 0.5)}, normalized({s * 0.25, -1.0, 0.05}),
+  const Vec3 back = shellPoint({s * 26.0, -58.0, 4.0 + 12.0 * (occipital - 0.5)}, glm::normalize(Vec3{s * 0.25, -1.0, 0.05}),
                                corticalDepth(rng));
   const Vec3 front = shellPoint({s * 24.0, 34.0, 2.0 + 14.0 * (frontal - 0.5)},
-                                normalized({s * (0.15 + 0.3 * frontal), 1.0, 0.1}), corticalDepth(rng));
+                                glm::normalize(Vec3{s * (0.15 + 0.3 * frontal), 1.0, 0.1}), corticalDepth(rng));
   q = {back, Vec3{s * 30.0, -48.0, 2.0}, Vec3{s * 34.0, -24.0, -4.0}, Vec3{s * 31.0, -2.0, -8.0},
        Vec3{s * 27.0, 18.0, -2.0}, front};
   static constexpr double kRadius[] = {3.0, 3.5, 3.0, 2.5, 3.0, 3.5};
@@ -150,8 +150,8 @@ void ifof(Rng& rng, double s, std::vector<Vec3>& q) {
 void ilf(Rng& rng, double s, std::vector<Vec3>& q) {
   const double occipital = rng.uniform();
   const Vec3 back = shellPoint({s * 32.0, -56.0, -2.0 + 10.0 * (occipital - 0.5)},
-                               normalized({s * 0.35, -1.0, -0.1}), corticalDepth(rng));
-  const Vec3 front = shellPoint({s * 38.0, 10.0, -27.0}, normalized({s * 0.2, 1.0, -0.25}), corticalDepth(rng));
+                               glm::normalize(Vec3{s * 0.35, -1.0, -0.1}), corticalDepth(rng));
+  const Vec3 front = shellPoint({s * 38.0, 10.0, -27.0}, glm::normalize(Vec3{s * 0.2, 1.0, -0.25}), corticalDepth(rng));
   q = {back, Vec3{s * 38.0, -44.0, -6.0}, Vec3{s * 42.0, -22.0, -16.0}, Vec3{s * 40.0, -2.0, -25.0}, front};
   static constexpr double kRadius[] = {3.5, 3.5, 3.0, 3.0, 3.0};
   double u, v;
@@ -166,7 +166,7 @@ void ilf(Rng& rng, double s, std::vector<Vec3>& q) {
 void uFiber(Rng& rng, std::vector<Vec3>& q) {
   const auto& sites = uFiberSites();
   const UFiberSite& site = sites[size_t(rng.next() % sites.size())];
-  const Vec3 across = cross(site.centre, site.tangent);
+  const Vec3 across = glm::cross(site.centre, site.tangent);
   const double half_span = 0.5 * site.span_mm * rng.uniform(0.85, 1.15);
   const double offset = rng.uniform(-3.0, 3.0);
   const double bottom = rng.uniform(0.84, 0.88), top = rng.uniform(0.95, 0.98);
@@ -197,8 +197,8 @@ const std::vector<UFiberSite>& uFiberSites() {
       const double tangent_angle = 2.0 * kPi * rng.uniform();
       const double span = rng.uniform(16.0, 28.0);
       if (z < -0.4) continue;
-      const Vec3 e1 = normalized(cross(centre, std::abs(centre.z) < 0.9 ? Vec3{0, 0, 1} : Vec3{1, 0, 0}));
-      const Vec3 e2 = cross(centre, e1);
+      const Vec3 e1 = glm::normalize(glm::cross(centre, std::abs(centre.z) < 0.9 ? Vec3{0, 0, 1} : Vec3{1, 0, 0}));
+      const Vec3 e2 = glm::cross(centre, e1);
       out.push_back({centre, std::cos(tangent_angle) * e1 + std::sin(tangent_angle) * e2, span});
     }
     return out;

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <vector>
 
 #include "phantom/phantom.h"
@@ -17,16 +18,11 @@ namespace fibscope::phantom_detail {
 inline constexpr double kPi = 3.14159265358979323846;
 inline double radians(double degrees) { return degrees * (kPi / 180.0); }
 
-struct Vec3 {
-  double x = 0, y = 0, z = 0;
-};
-inline Vec3 operator+(Vec3 a, Vec3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-inline Vec3 operator-(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-inline Vec3 operator*(double s, Vec3 a) { return {s * a.x, s * a.y, s * a.z}; }
-inline double dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-inline Vec3 cross(Vec3 a, Vec3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
-inline double norm(Vec3 a) { return std::sqrt(dot(a, a)); }
-inline Vec3 normalized(Vec3 a) { return (1.0 / norm(a)) * a; }
+// glm's arithmetic is the phantom's: its dot, cross, length and normalize
+// evaluate in the order the phantom's own functions did, so the phantom
+// stays bit for bit what it was (its determinism tests pin it).
+using Vec3 = glm::dvec3;
+// a + t (b - a), not glm::mix (a (1 - t) + b t rounds differently).
 inline Vec3 lerp(Vec3 a, Vec3 b, double t) { return a + t * (b - a); }
 inline double lerp(double a, double b, double t) { return a + t * (b - a); }
 inline double smoothstep(double edge0, double edge1, double x) {

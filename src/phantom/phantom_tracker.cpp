@@ -14,7 +14,7 @@ Vec3 shellPoint(Vec3 origin, Vec3 direction, double rho) {
   const Vec3 inv = {1.0 / kPhantomSemiAxesMm[0], 1.0 / kPhantomSemiAxesMm[1], 1.0 / kPhantomSemiAxesMm[2]};
   const Vec3 o = {origin.x * inv.x, origin.y * inv.y, origin.z * inv.z};
   const Vec3 d = {direction.x * inv.x, direction.y * inv.y, direction.z * inv.z};
-  const double a = dot(d, d), b = dot(o, d), c = dot(o, o) - rho * rho;
+  const double a = glm::dot(d, d), b = glm::dot(o, d), c = glm::dot(o, o) - rho * rho;
   const double t = (-b + std::sqrt(std::max(0.0, b * b - a * c))) / a;
   return origin + t * direction;
 }
@@ -36,9 +36,9 @@ void buildGuide(const std::vector<Vec3>& controls, double spacing, Guide& guide)
     const Vec3 p0 = control(ptrdiff_t(span) - 1), p1 = control(ptrdiff_t(span)), p2 = control(ptrdiff_t(span) + 1),
                p3 = control(ptrdiff_t(span) + 2);
     // Centripetal knots: t_{i+1} - t_i = |P_{i+1} - P_i|^(1/2).
-    const double t0 = 0, t1 = t0 + std::sqrt(std::max(norm(p1 - p0), 1e-9)),
-                 t2 = t1 + std::sqrt(std::max(norm(p2 - p1), 1e-9)), t3 = t2 + std::sqrt(std::max(norm(p3 - p2), 1e-9));
-    const size_t samples = std::max<size_t>(1, size_t(std::ceil(norm(p2 - p1) / spacing)));
+    const double t0 = 0, t1 = t0 + std::sqrt(std::max(glm::length(p1 - p0), 1e-9)),
+                 t2 = t1 + std::sqrt(std::max(glm::length(p2 - p1), 1e-9)), t3 = t2 + std::sqrt(std::max(glm::length(p3 - p2), 1e-9));
+    const size_t samples = std::max<size_t>(1, size_t(std::ceil(glm::length(p2 - p1) / spacing)));
     const double r10 = 1.0 / (t1 - t0), r21 = 1.0 / (t2 - t1), r32 = 1.0 / (t3 - t2), r20 = 1.0 / (t2 - t0),
                  r31 = 1.0 / (t3 - t1);
     for (size_t k = 0; k < samples; ++k) {
@@ -58,12 +58,12 @@ void buildGuide(const std::vector<Vec3>& controls, double spacing, Guide& guide)
   // every tangent is a unit vector.
   size_t kept = 1;
   for (size_t i = 1; i < guide.points.size(); ++i)
-    if (norm(guide.points[i] - guide.points[kept - 1]) > 1e-9) guide.points[kept++] = guide.points[i];
+    if (glm::length(guide.points[i] - guide.points[kept - 1]) > 1e-9) guide.points[kept++] = guide.points[i];
   guide.points.resize(kept);
   guide.arc.push_back(0.0);
   for (size_t i = 0; i + 1 < guide.points.size(); ++i) {
     const Vec3 chord = guide.points[i + 1] - guide.points[i];
-    const double length = norm(chord);
+    const double length = glm::length(chord);
     guide.tangents.push_back((1.0 / length) * chord);
     guide.arc.push_back(guide.arc.back() + length);
   }
@@ -114,10 +114,10 @@ size_t trackAlongGuide(const Guide& guide, double start_arc, size_t steps, const
   auto pursue = [&] {
     // Projection on the current guide segment, moving on while the fiber has
     // passed the segment's end.
-    double along = arc[seg] + dot(pos - points[seg], tangents[seg]);
+    double along = arc[seg] + glm::dot(pos - points[seg], tangents[seg]);
     while (along > ends[seg]) {
       ++seg;
-      along = arc[seg] + dot(pos - points[seg], tangents[seg]);
+      along = arc[seg] + glm::dot(pos - points[seg], tangents[seg]);
     }
     const double target_arc = along + params.lookahead;
     if (target_seg < seg) target_seg = seg;
@@ -146,20 +146,20 @@ size_t trackAlongGuide(const Guide& guide, double start_arc, size_t steps, const
       rng.normal2(gz, unused);
       next = next + params.jitter_sigma * Vec3{gx, gy, gz};
     }
-    next = (1.0 / norm(next)) * next;
+    next = (1.0 / glm::length(next)) * next;
 
     // Bound the turn: rotate `dir` by exactly the maximum angle towards
     // `next` when the turn would exceed it.
-    const double cos_turn = dot(dir, next);
+    const double cos_turn = glm::dot(dir, next);
     if (cos_turn < params.cos_max_turn) {
       Vec3 side = next - cos_turn * dir;
-      double side_length = norm(side);
+      double side_length = glm::length(side);
       if (side_length < 1e-12) {  // a full reversal: any perpendicular will do
-        side = std::abs(dir.x) < 0.9 ? cross(dir, Vec3{1, 0, 0}) : cross(dir, Vec3{0, 1, 0});
-        side_length = norm(side);
+        side = std::abs(dir.x) < 0.9 ? glm::cross(dir, Vec3{1, 0, 0}) : glm::cross(dir, Vec3{0, 1, 0});
+        side_length = glm::length(side);
       }
       next = params.cos_max_turn * dir + (params.sin_max_turn / side_length) * side;
-      next = (1.0 / norm(next)) * next;
+      next = (1.0 / glm::length(next)) * next;
     }
 
     const Vec3 p = pos + params.step * next;

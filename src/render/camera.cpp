@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <glm/glm.hpp>
+#include <glm/gtc/type_ptr.hpp>
 #include <limits>
 #include <numbers>
 #include <string>
@@ -13,13 +15,16 @@ namespace {
 
 using Mat4d = std::array<double, 16>;
 
-Vec3d sub(Vec3d a, Vec3d b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-double dot(Vec3d a, Vec3d b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-Vec3d cross(Vec3d a, Vec3d b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+glm::dvec3 vec(const Vec3d& a) { return {a[0], a[1], a[2]}; }
+
+// Column-major both ways (glm's and camera.h's layout).
+glm::dmat4 toGlm(const Mat4d& m) { return glm::make_mat4(m.data()); }
+Mat4d fromGlm(const glm::dmat4& m) {
+  Mat4d out{};
+  const double* p = glm::value_ptr(m);
+  std::copy(p, p + 16, out.begin());
+  return out;
 }
-double length(Vec3d a) { return std::sqrt(dot(a, a)); }
-Vec3d scale(Vec3d a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
 
 double radians(double deg) { return deg * std::numbers::pi / 180.0; }
 
@@ -29,28 +34,17 @@ Mat4 toFloat(const Mat4d& m) {
   return out;
 }
 
-Mat4d multiply(const Mat4d& a, const Mat4d& b) {  // a * b, column-major
-  Mat4d out{};
-  for (int c = 0; c < 4; ++c)
-    for (int r = 0; r < 4; ++r) {
-      double sum = 0;
-      for (int k = 0; k < 4; ++k) sum += a[4 * k + r] * b[4 * c + k];
-      out[4 * c + r] = sum;
-    }
-  return out;
-}
-
 }  // namespace
 
 void validateCamera(const Camera& camera) {
-  const Vec3d forward = sub(camera.target, camera.eye);
-  const double forward_length = length(forward);
+  const glm::dvec3 forward = vec(camera.target) - vec(camera.eye);
+  const double forward_length = glm::length(forward);
   if (!(forward_length > 0) || !std::isfinite(forward_length))
     fail("camera", "eye and target must be distinct finite points");
-  const double up_length = length(camera.up);
+  const double up_length = glm::length(vec(camera.up));
   if (!(up_length > 0) || !std::isfinite(up_length)) fail("camera", "up must be a finite non-zero vector");
   // sin of the angle between up and the view direction.
-  if (length(cross(forward, camera.up)) <= 1e-9 * forward_length * up_length)
+  if (glm::length(glm::cross(forward, vec(camera.up))) <= 1e-9 * forward_length * up_length)
     fail("camera", "up must not be parallel to the view direction");
   if (!(camera.fov_y_deg > 0 && camera.fov_y_deg < 180))
     fail("camera", "vertical field of view must lie in (0, 180) degrees, got " + std::to_string(camera.fov_y_deg));
@@ -62,15 +56,15 @@ void validateCamera(const Camera& camera) {
 
 std::array<double, 16> viewMatrixD(const Camera& camera) {
   validateCamera(camera);
-  const Vec3d f = scale(sub(camera.target, camera.eye), 1.0 / length(sub(camera.target, camera.eye)));
-  Vec3d s = cross(f, camera.up);
-  s = scale(s, 1.0 / length(s));
-  const Vec3d u = cross(s, f);
+  const glm::dvec3 eye = vec(camera.eye);
+  const glm::dvec3 f = glm::normalize(vec(camera.target) - eye);
+  const glm::dvec3 s = glm::normalize(glm::cross(f, vec(camera.up)));
+  const glm::dvec3 u = glm::cross(s, f);
   // Rows: s, u, -f; translation moves the eye to the origin.
-  return {s[0], u[0], -f[0], 0,  //
-          s[1], u[1], -f[1], 0,  //
-          s[2], u[2], -f[2], 0,  //
-          -dot(s, camera.eye), -dot(u, camera.eye), dot(f, camera.eye), 1};
+  return {s.x, u.x, -f.x, 0,  //
+          s.y, u.y, -f.y, 0,  //
+          s.z, u.z, -f.z, 0,  //
+          -glm::dot(s, eye), -glm::dot(u, eye), glm::dot(f, eye), 1};
 }
 
 std::array<double, 16> projectionMatrixD(const Camera& camera) {
@@ -88,7 +82,7 @@ std::array<double, 16> projectionMatrixD(const Camera& camera) {
 }
 
 std::array<double, 16> viewProjectionD(const Camera& camera) {
-  return multiply(projectionMatrixD(camera), viewMatrixD(camera));
+  return fromGlm(toGlm(projectionMatrixD(camera)) * toGlm(viewMatrixD(camera)));
 }
 
 Mat4 viewMatrix(const Camera& camera) { return toFloat(viewMatrixD(camera)); }
@@ -126,7 +120,7 @@ Bounds tractogramBounds(const Tractogram& tractogram) {
 
 Camera fitCamera(const Bounds& bounds, Vec3d direction, Vec3d up, uint32_t width, uint32_t height,
                  double distance_factor, double fov_y_deg) {
-  const double direction_length = length(direction);
+  const double direction_length = glm::length(vec(direction));
   if (!(direction_length > 0)) fail("camera", "fit: view direction must be non-zero");
   if (!(distance_factor > 0)) fail("camera", "fit: distance factor must be positive");
   if (width == 0 || height == 0) fail("camera", "image size must be at least 1 x 1");
@@ -134,7 +128,7 @@ Camera fitCamera(const Bounds& bounds, Vec3d direction, Vec3d up, uint32_t width
   const Vec3d centre = {(bounds.min[0] + bounds.max[0]) / 2, (bounds.min[1] + bounds.max[1]) / 2,
                         (bounds.min[2] + bounds.max[2]) / 2};
   // A box of size 0 still gets a 1 mm sphere, so the matrices stay valid.
-  const double radius = std::max(length(sub(bounds.max, bounds.min)) / 2, 1.0);
+  const double radius = std::max(glm::length(vec(bounds.max) - vec(bounds.min)) / 2, 1.0);
   const double half_fov_y = radians(fov_y_deg) / 2;
   const double half_fov_x = std::atan(std::tan(half_fov_y) * double(width) / double(height));
   // A sphere of radius r at distance d fills a cone of half-angle asin(r / d).

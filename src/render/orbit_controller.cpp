@@ -10,16 +10,15 @@
 namespace fibscope {
 namespace {
 
-Vec3d add(Vec3d a, Vec3d b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
-Vec3d sub(Vec3d a, Vec3d b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-Vec3d scale(Vec3d a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
-double dot(Vec3d a, Vec3d b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-double length(Vec3d a) { return std::sqrt(dot(a, a)); }
-Vec3d cross(Vec3d a, Vec3d b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-Vec3d unit(Vec3d a) { return scale(a, 1.0 / length(a)); }
+glm::dvec3 vec(const Vec3d& a) { return {a[0], a[1], a[2]}; }
+Vec3d array(const glm::dvec3& a) { return {a.x, a.y, a.z}; }
 double radians(double deg) { return deg * std::numbers::pi / 180.0; }
+
+// glm::normalize, and the identity for a quaternion of no finite length.
+Quat unitOrIdentity(const Quat& q) {
+  const double n = glm::length(q);
+  return n > 0 && std::isfinite(n) ? q / n : Quat{};
+}
 
 std::array<Vec3d, 8> cornersOf(const Bounds& b) {
   std::array<Vec3d, 8> corners;
@@ -28,93 +27,27 @@ std::array<Vec3d, 8> cornersOf(const Bounds& b) {
   return corners;
 }
 // Radius of the box's bounding sphere, at least 1 mm (fitCamera's rule).
-double radiusOf(const Bounds& b) { return std::max(length(sub(b.max, b.min)) / 2, 1.0); }
+double radiusOf(const Bounds& b) { return std::max(glm::length(vec(b.max) - vec(b.min)) / 2, 1.0); }
 
 // The orientation of a camera whose eye lies on `back` from the target with
-// `up` (projected orthogonal to back), as camera.h's viewMatrix builds it.
-Quat orientationOf(Vec3d back, Vec3d up) {
-  const Vec3d z = unit(back);
-  const Vec3d x = unit(cross(up, z));
-  const Vec3d y = cross(z, x);
-  return quatFromAxes(x, y, z);
+// `up` (projected orthogonal to back), as camera.h's viewMatrix builds it:
+// the rotation whose columns are its right, up and back axes.
+Quat orientationOf(const Vec3d& back, const Vec3d& up) {
+  const glm::dvec3 z = glm::normalize(vec(back));
+  const glm::dvec3 x = glm::normalize(glm::cross(vec(up), z));
+  const glm::dvec3 y = glm::cross(z, x);
+  return unitOrIdentity(glm::quat_cast(glm::dmat3(x, y, z)));
 }
 
 // Angle between two orientations, radians in [0, pi].
 double angleBetween(const Quat& a, const Quat& b) {
-  const double d = std::fabs(a.w * b.w + a.x * b.x + a.y * b.y + a.z * b.z);
-  return 2 * std::acos(std::min(d, 1.0));
+  return 2 * std::acos(std::min(std::fabs(glm::dot(a, b)), 1.0));
 }
+
+// The camera's axis `local` (x right, y up, z back) in world space.
+Vec3d axis(const Quat& q, const glm::dvec3& local) { return array(q * local); }
 
 }  // namespace
-
-Quat quatNormalize(const Quat& q) {
-  const double n = std::sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
-  if (!(n > 0) || !std::isfinite(n)) return Quat{};
-  return {q.w / n, q.x / n, q.y / n, q.z / n};
-}
-
-Quat quatMultiply(const Quat& a, const Quat& b) {
-  return {a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z,  //
-          a.w * b.x + a.x * b.w + a.y * b.z - a.z * b.y,  //
-          a.w * b.y - a.x * b.z + a.y * b.w + a.z * b.x,  //
-          a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w};
-}
-
-Vec3d quatRotate(const Quat& q, const Vec3d& v) {
-  // v + 2 w (u x v) + 2 u x (u x v), u the vector part.
-  const Vec3d u = {q.x, q.y, q.z};
-  const Vec3d t = scale(cross(u, v), 2);
-  return add(add(v, scale(t, q.w)), cross(u, t));
-}
-
-Quat quatAxisAngle(const Vec3d& unit_axis, double radians) {
-  const double s = std::sin(radians / 2);
-  return {std::cos(radians / 2), unit_axis[0] * s, unit_axis[1] * s, unit_axis[2] * s};
-}
-
-Quat quatSlerp(const Quat& a, const Quat& b_in, double t) {
-  Quat b = b_in;
-  double d = a.w * b.w + a.x * b.x + a.y * b.y + a.z * b.z;
-  if (d < 0) {  // q and -q are the same rotation: take the short way
-    b = {-b.w, -b.x, -b.y, -b.z};
-    d = -d;
-  }
-  double wa, wb;
-  if (d > 1 - 1e-12) {  // nearly equal: the chord is the arc
-    wa = 1 - t;
-    wb = t;
-  } else {
-    const double theta = std::acos(d);
-    const double s = std::sin(theta);
-    wa = std::sin((1 - t) * theta) / s;
-    wb = std::sin(t * theta) / s;
-  }
-  return quatNormalize({wa * a.w + wb * b.w, wa * a.x + wb * b.x, wa * a.y + wb * b.y, wa * a.z + wb * b.z});
-}
-
-Quat quatFromAxes(const Vec3d& x, const Vec3d& y, const Vec3d& z) {
-  // Rotation matrix with columns x, y, z (Shepperd's method: pivot on the
-  // largest of w, x, y, z for accuracy).
-  const double m00 = x[0], m10 = x[1], m20 = x[2];
-  const double m01 = y[0], m11 = y[1], m21 = y[2];
-  const double m02 = z[0], m12 = z[1], m22 = z[2];
-  const double trace = m00 + m11 + m22;
-  Quat q;
-  if (trace > 0) {
-    const double s = 2 * std::sqrt(1 + trace);
-    q = {s / 4, (m21 - m12) / s, (m02 - m20) / s, (m10 - m01) / s};
-  } else if (m00 > m11 && m00 > m22) {
-    const double s = 2 * std::sqrt(1 + m00 - m11 - m22);
-    q = {(m21 - m12) / s, s / 4, (m01 + m10) / s, (m02 + m20) / s};
-  } else if (m11 > m22) {
-    const double s = 2 * std::sqrt(1 + m11 - m00 - m22);
-    q = {(m02 - m20) / s, (m01 + m10) / s, s / 4, (m12 + m21) / s};
-  } else {
-    const double s = 2 * std::sqrt(1 + m22 - m00 - m11);
-    q = {(m10 - m01) / s, (m02 + m20) / s, (m12 + m21) / s, s / 4};
-  }
-  return quatNormalize(q);
-}
 
 OrbitController::OrbitController() {
   // A unit box at the origin until frame() gives the model's.
@@ -136,8 +69,8 @@ OrbitController::State OrbitController::defaultState() const {
   }
   State state;
   state.target = fitted.target;
-  const Vec3d back = sub(fitted.eye, fitted.target);
-  state.distance = length(back);
+  const Vec3d back = array(vec(fitted.eye) - vec(fitted.target));
+  state.distance = glm::length(vec(back));
   state.orientation = orientationOf(back, fitted.up);
   return state;
 }
@@ -168,10 +101,10 @@ void OrbitController::rotate(double dx_px, double dy_px) {
   // the eye towards the image's right, so the scene moves left: negate to
   // make the scene follow the cursor. Likewise about the right axis a
   // positive angle moves the eye down; dragging down (dy > 0) must move it up.
-  const Quat turn = quatMultiply(quatAxisAngle({0, 1, 0}, -radians(dx_px * kDegreesPerPixel)),
-                                 quatAxisAngle({1, 0, 0}, -radians(dy_px * kDegreesPerPixel)));
+  const Quat turn = glm::angleAxis(-radians(dx_px * kDegreesPerPixel), glm::dvec3(0, 1, 0)) *
+                    glm::angleAxis(-radians(dy_px * kDegreesPerPixel), glm::dvec3(1, 0, 0));
   // Local axes: right-multiply (the rotation is expressed in the camera frame).
-  goal_.orientation = quatNormalize(quatMultiply(goal_.orientation, turn));
+  goal_.orientation = unitOrIdentity(goal_.orientation * turn);
 }
 
 void OrbitController::pan(double dx_px, double dy_px) {
@@ -182,11 +115,11 @@ void OrbitController::pan(double dx_px, double dy_px) {
   // in view space at the same depth, i.e. by delta / mm_per_px pixels.
   const double mm_per_px =
       2 * goal_.distance * std::tan(radians(fov_y_deg_) / 2) / double(std::max<uint32_t>(viewport_height_, 1));
-  const Vec3d right = quatRotate(goal_.orientation, {1, 0, 0});
-  const Vec3d up = quatRotate(goal_.orientation, {0, 1, 0});
+  const glm::dvec3 right = goal_.orientation * glm::dvec3(1, 0, 0);
+  const glm::dvec3 up = goal_.orientation * glm::dvec3(0, 1, 0);
   // Window y points down: dragging down must move the point down, so the
   // target moves up.
-  Vec3d target = add(goal_.target, add(scale(right, -dx_px * mm_per_px), scale(up, dy_px * mm_per_px)));
+  Vec3d target = array(vec(goal_.target) + right * (-dx_px * mm_per_px) + up * (dy_px * mm_per_px));
   // Keep the target within the box grown by its diagonal either side, so the
   // model cannot be lost far off screen.
   const double slack = 2 * radiusOf(bounds_);
@@ -226,7 +159,8 @@ void OrbitController::update(double dt_seconds) {
   const double keep = std::exp(-dt_seconds / kTimeConstantSeconds);
   for (int k = 0; k < 3; ++k) shown_.target[k] = goal_.target[k] + (shown_.target[k] - goal_.target[k]) * keep;
   shown_.distance = goal_.distance * std::exp((std::log(shown_.distance) - std::log(goal_.distance)) * keep);
-  shown_.orientation = quatSlerp(shown_.orientation, goal_.orientation, 1 - keep);
+  // Shortest path (glm::slerp turns q into -q where that is nearer).
+  shown_.orientation = unitOrIdentity(glm::slerp(shown_.orientation, goal_.orientation, 1 - keep));
   if (!animating()) shown_ = goal_;
 }
 
@@ -234,7 +168,7 @@ bool OrbitController::animating() const {
   // Below these the motion is far under a pixel: 1e-6 of the distance, a
   // microradian.
   const double eps = 1e-6 * goal_.distance;
-  return length(sub(shown_.target, goal_.target)) > eps || std::fabs(shown_.distance - goal_.distance) > eps ||
+  return glm::length(vec(shown_.target) - vec(goal_.target)) > eps || std::fabs(shown_.distance - goal_.distance) > eps ||
          angleBetween(shown_.orientation, goal_.orientation) > 1e-6;
 }
 
@@ -247,11 +181,11 @@ void OrbitController::setViewport(uint32_t width, uint32_t height) {
 }
 
 Camera OrbitController::makeCamera(const State& state, uint32_t width, uint32_t height) const {
-  const Vec3d back = quatRotate(state.orientation, {0, 0, 1});
+  const glm::dvec3 back = state.orientation * glm::dvec3(0, 0, 1);
   Camera camera;
   camera.target = state.target;
-  camera.eye = add(state.target, scale(back, state.distance));
-  camera.up = quatRotate(state.orientation, {0, 1, 0});
+  camera.eye = array(vec(state.target) + back * state.distance);
+  camera.up = axis(state.orientation, {0, 1, 0});
   camera.fov_y_deg = fov_y_deg_;
   camera.width = std::max<uint32_t>(width, 1);
   camera.height = std::max<uint32_t>(height, 1);
@@ -260,10 +194,10 @@ Camera OrbitController::makeCamera(const State& state, uint32_t width, uint32_t 
   // range is its corners'. Near keeps a floor of 1e-4 of the distance when
   // the eye is inside (or right at) the box: the part behind it is clipped
   // anyway, and a tiny positive near keeps the matrices valid.
-  const Vec3d forward = scale(back, -1);
+  const glm::dvec3 forward = -back;
   double min_depth = std::numeric_limits<double>::infinity(), max_depth = -min_depth;
   for (const Vec3d& corner : cornersOf(bounds_)) {
-    const double depth = dot(sub(corner, camera.eye), forward);
+    const double depth = glm::dot(vec(corner) - vec(camera.eye), forward);
     min_depth = std::min(min_depth, depth);
     max_depth = std::max(max_depth, depth);
   }

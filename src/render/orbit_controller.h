@@ -17,16 +17,16 @@
 #include <array>
 #include <cstdint>
 #include <span>
+#include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
 #include <vector>
 
 #include "render/camera.h"
 
 namespace fibscope {
 
-// Unit quaternion (w, x, y, z) as a rotation.
-struct Quat {
-  double w = 1, x = 0, y = 0, z = 0;
-};
+// Unit quaternion (w, x, y, z) as a rotation; identity by default.
+using Quat = glm::dquat;
 
 class OrbitController {
  public:
@@ -128,16 +128,5 @@ class OrbitController {
   // sees is the one pan() must match).
   mutable uint32_t viewport_width_ = 1280, viewport_height_ = 720;
 };
-
-// Quaternion helpers (exposed for the tests).
-Quat quatNormalize(const Quat& q);
-// a * b: quatRotate(a * b, v) == quatRotate(a, quatRotate(b, v)).
-Quat quatMultiply(const Quat& a, const Quat& b);
-Vec3d quatRotate(const Quat& q, const Vec3d& v);
-Quat quatAxisAngle(const Vec3d& unit_axis, double radians);
-// Shortest-path spherical interpolation, t in [0, 1].
-Quat quatSlerp(const Quat& a, const Quat& b, double t);
-// The orientation whose local +x, +y, +z are the given orthonormal right-handed axes.
-Quat quatFromAxes(const Vec3d& right, const Vec3d& up, const Vec3d& back);
 
 }  // namespace fibscope
