@@ -21,8 +21,9 @@ command -v clang++ >/dev/null || { echo "fuzz: clang++ is missing (apt-get insta
 ninja -C build-fuzz --quiet
 
 # Seeds: tiny phantoms in every writable format, made by the normal build.
+# (The fuzz build has the readers only: the seeds come from the main build.)
 fibscope=build/fibscope
-[ -x "$fibscope" ] || fibscope=build-fuzz/fibscope
+[ -x "$fibscope" ] || { echo "fuzz: $fibscope is missing: build the main build first (./setup.sh run)" >&2; exit 1; }
 seeds=build-fuzz/seeds
 rm -rf "$seeds"; mkdir -p "$seeds"/{tck,trk,trx,vtk}
 for fmt in tck trk trx; do

@@ -1,4 +1,4 @@
-// Decodes every fiblet of an uploaded dataset (render/gpu_dataset.h) to
+// Decodes every fiblet of an uploaded dataset (render/gpu/dataset.h) to
 // normalised points, reading the records, the direction table, N, delta and
 // V only through the FibletDataset block: the GPU test checks that what the
 // uploader wrote is what a pass needs, bit for bit against the CPU scan.

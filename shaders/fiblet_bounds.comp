@@ -1,6 +1,6 @@
 // Exact bounding spheres of the fiblets (DESIGN.md section 6, step 1), run
 // once per dataset, in the first frame that culls by occlusion
-// (render/gpu_fiblet_bounds.h, GpuDataset::recordFibletBoundsOnce): one
+// (render/gpu/fiblet_bounds.h, GpuDataset::recordFibletBoundsOnce): one
 // invocation per fiblet decodes it front to back exactly as
 // fiblet_raster_serial.comp does (W_1, then W_1 L_2 ... L_k, points in
 // normalised units, then fibletToWorld) and writes one vec4 to the

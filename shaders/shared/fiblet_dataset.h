@@ -1,4 +1,4 @@
-// The description of a dataset on the GPU (render/gpu_dataset.h uploads
+// The description of a dataset on the GPU (render/gpu/dataset.h uploads
 // it), shared by the shaders and the C++ that fills it.
 //
 // It lives in a small device-local buffer of its own, and a pass receives
@@ -44,7 +44,7 @@ struct FibletDataset {
   uint64_t fiber_length_mm;
   // vec4 per fiblet, or 0 (none): each fiblet's bounding sphere in world mm
   // (xyz centre, w radius; w < 0: the fiblet draws nothing), computed on the
-  // device after the upload by fiblet_bounds.comp (render/gpu_fiblet_bounds.h).
+  // device after the upload by fiblet_bounds.comp (render/gpu/fiblet_bounds.h).
   // The cull uses it when present, else a looser bound from the record.
   uint64_t fiblet_bounds;
   uint fiber_count;

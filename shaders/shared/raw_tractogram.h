@@ -1,4 +1,4 @@
-// An uncompressed tractogram on the GPU (render/gpu_raw_tractogram.h
+// An uncompressed tractogram on the GPU (render/gpu/raw_tractogram.h
 // uploads it) for the two baseline pipelines every speed figure is compared
 // against (DESIGN.md section 6): `lines` (line strips through the graphics
 // pipeline) and `raw-compute` (the compute raster over raw vertices, the
@@ -20,7 +20,7 @@
 SHADER_NAMESPACE_BEGIN
 
 // The points come in chunks of whole streamlines, one device buffer each
-// (render/gpu_raw_tractogram.h): a single buffer may exceed neither the
+// (render/gpu/raw_tractogram.h): a single buffer may exceed neither the
 // device's largest allocation (4 GiB on NVIDIA, while the paper's 500 k
 // fiber tractogram has 4.8 GiB of vertices) nor its largest buffer. A
 // streamline never straddles two chunks, so the lines pipeline draws each

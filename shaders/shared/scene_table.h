@@ -1,6 +1,6 @@
 // The scene table: which datasets a frame draws and where each one's
 // fiblets and fibers start in the scene-global numbering (DESIGN.md
-// section 6; render/gpu_scene_table.h builds it, the frame renderer
+// section 6; render/gpu/scene_table.h builds it, the frame renderer
 // uploads it with the camera block each frame).
 //
 // Several models are drawn into one visibility buffer. Each drawn dataset

@@ -22,7 +22,7 @@
 #include "app/render_scene.h"
 #include "core/error.h"
 #include "render/camera.h"
-#include "render/gpu_frame_renderer.h"
+#include "render/gpu/frame_renderer.h"
 
 namespace fibscope {
 namespace {

@@ -15,9 +15,9 @@
 #include "app/render_options.h"
 #include "app/render_scene.h"
 #include "core/error.h"
+#include "io/png_writer.h"
 #include "render/camera.h"
-#include "render/gpu_frame_renderer.h"
-#include "render/png_writer.h"
+#include "render/gpu/frame_renderer.h"
 
 namespace fibscope {
 namespace {

@@ -10,8 +10,8 @@
 #include <string_view>
 
 #include "gpu/vulkan_context.h"
-#include "render/gpu_dataset.h"
-#include "render/gpu_frame_renderer.h"
+#include "render/gpu/dataset.h"
+#include "render/gpu/frame_renderer.h"
 #include "render/render_settings.h"
 
 namespace CLI {

@@ -7,7 +7,7 @@
 #include "codec/fbl_file.h"
 #include "io/reader.h"
 #include "phantom/phantom.h"
-#include "render/gpu_tractogram_upload.h"
+#include "render/gpu/tractogram_upload.h"
 
 namespace fibscope {
 namespace {

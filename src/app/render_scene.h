@@ -11,10 +11,10 @@
 #include "core/tractogram.h"
 #include "gpu/vulkan_context.h"
 #include "render/camera.h"
-#include "render/gpu_dataset.h"
-#include "render/gpu_frame_renderer.h"
-#include "render/gpu_raw_tractogram.h"
-#include "render/gpu_tractogram_upload.h"
+#include "render/gpu/dataset.h"
+#include "render/gpu/frame_renderer.h"
+#include "render/gpu/raw_tractogram.h"
+#include "render/gpu/tractogram_upload.h"
 
 namespace fibscope {
 
@@ -43,7 +43,7 @@ struct LoadedScene {
 // malformed input, and for a dataset that does not fit on the device.
 LoadedScene loadScene(const gpu::VulkanContext& context, const SceneOptions& options);
 // The same with the device made meanwhile (see ContextSource in
-// render/gpu_tractogram_upload.h): `context` is called when an upload
+// render/gpu/tractogram_upload.h): `context` is called when an upload
 // starts, after the reading and encoding.
 LoadedScene loadScene(const ContextSource& context, const SceneOptions& options);
 

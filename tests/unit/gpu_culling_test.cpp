@@ -1,5 +1,5 @@
 // The cull passes of the compute pipeline (DESIGN.md section 6, step 1;
-// src/render/gpu_cull_passes.h): culling must be conservative, so two-phase
+// src/render/gpu/cull_passes.h): culling must be conservative, so two-phase
 // occlusion culling and frustum culling with LoD off give the SAME frame as
 // drawing every fiblet (visibility keys, hence coverage, depth and fiber
 // ids, bit for bit) on every frame of an orbit, across a 60 degree jump
@@ -19,9 +19,9 @@
 #include "io/reader.h"
 #include "phantom/phantom.h"
 #include "render/camera.h"
-#include "render/gpu_cull_passes.h"
-#include "render/gpu_frame_renderer.h"
-#include "render/gpu_tractogram_upload.h"
+#include "render/gpu/cull_passes.h"
+#include "render/gpu/frame_renderer.h"
+#include "render/gpu/tractogram_upload.h"
 #include "render/image_compare.h"
 #include "shared/cull_push.h"
 #include "shared/render_config.h"

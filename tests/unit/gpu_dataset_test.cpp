@@ -1,4 +1,4 @@
-// GpuDataset (render/gpu_dataset.h): a compressed phantom uploaded from its
+// GpuDataset (render/gpu/dataset.h): a compressed phantom uploaded from its
 // .fbl (and from an in-memory encode) must land on the device byte for byte
 // as the file's sections and the tables derived from them; a pass reading
 // only through the FibletDataset block must decode every fiblet bit for bit
@@ -24,7 +24,7 @@
 #include "gpu_test_context.h"
 #include "io/reader.h"
 #include "phantom/phantom.h"
-#include "render/gpu_dataset.h"
+#include "render/gpu/dataset.h"
 #include "shared/dataset_decode_push.h"
 #include "test_support.h"
 

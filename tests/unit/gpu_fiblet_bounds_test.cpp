@@ -1,4 +1,4 @@
-// Per-fiblet bounding spheres (render/gpu_fiblet_bounds.h,
+// Per-fiblet bounding spheres (render/gpu/fiblet_bounds.h,
 // shaders/fiblet_bounds.comp): every point a fiblet draws, decoded on the
 // CPU in both composition orders (the serial rasters' and the
 // parallel-prefix scan's) and the joining point, lies inside the sphere the
@@ -22,9 +22,9 @@
 #include "gpu_render_test_support.h"
 #include "gpu_test_context.h"
 #include "render/camera.h"
-#include "render/gpu_fiblet_bounds.h"
-#include "render/gpu_frame_renderer.h"
-#include "render/gpu_tractogram_upload.h"
+#include "render/gpu/fiblet_bounds.h"
+#include "render/gpu/frame_renderer.h"
+#include "render/gpu/tractogram_upload.h"
 #include "shared/cull_push.h"
 #include "shared/fiblet.h"
 

@@ -1,4 +1,4 @@
-// The frame as a list of stages (render/gpu_frame_stage.h): the timer is
+// The frame as a list of stages (render/gpu/frame_stage.h): the timer is
 // sized from the list (a frame of 40 passes times every one), a stage is
 // one line in the list, and the surface target: analytic spheres drawn
 // with the lines by every pipeline occlude them and are occluded by them
@@ -16,10 +16,10 @@
 #include "gpu_render_test_support.h"
 #include "gpu_test_context.h"
 #include "render/camera.h"
-#include "render/gpu_frame_renderer.h"
-#include "render/gpu_pick.h"
-#include "render/gpu_raw_tractogram.h"
-#include "render/gpu_tractogram_upload.h"
+#include "render/gpu/frame_renderer.h"
+#include "render/gpu/pick.h"
+#include "render/gpu/raw_tractogram.h"
+#include "render/gpu/tractogram_upload.h"
 #include "render/image_compare.h"
 #include "render/reference_raster.h"
 #include "shared/gbuffer.h"
@@ -203,7 +203,7 @@ TEST_F(GpuFrameStages, spheresAndLinesOccludeEachOtherBothWaysAsTheReferenceInEv
     EXPECT_GE(s.agreement, 0.98) << "spheres: " << s.summary();
     EXPECT_LE(s.maxDistance(), 1.0) << "spheres: " << s.summary();
     // The device's line rasterisation is not the reference's capsule rule
-    // (gpu_lines_pass.h): only the compute pipelines are held to it.
+    // (lines_pass.h): only the compute pipelines are held to it.
     if (pipeline != RenderPipeline::Lines) {
       const CoverageComparison l = compareCoverage(got.lines, want.lines, kWidth, kHeight);
       EXPECT_GE(l.agreement, 0.98) << "lines: " << l.summary();

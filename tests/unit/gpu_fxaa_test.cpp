@@ -10,7 +10,7 @@
 
 #include "gpu/submit.h"
 #include "gpu_test_context.h"
-#include "render/gpu_shading_stages.h"
+#include "render/gpu/shading_stages.h"
 
 namespace fibscope {
 namespace {

@@ -10,8 +10,8 @@
 
 #include "gpu/buffer.h"
 #include "gpu/pass_scope.h"
-#include "render/gpu_frame_stage.h"
-#include "render/gpu_frame_stages.h"
+#include "render/gpu/frame_stage.h"
+#include "render/gpu/frame_stages.h"
 #include "shared/gbuffer.h"
 
 namespace fibscope::test {

@@ -1,4 +1,4 @@
-// Several models drawn in one frame (render/gpu_scene_table.h): the union of
+// Several models drawn in one frame (render/gpu/scene_table.h): the union of
 // two overlapping phantoms against the CPU reference of their raw union,
 // two-phase culling across models, hiding a model, picking and the
 // selection highlight with scene-global fiber ids. lavapipe with validation
@@ -15,11 +15,11 @@
 #include "gpu_render_test_support.h"
 #include "gpu_test_context.h"
 #include "render/camera.h"
-#include "render/gpu_fiber_attributes.h"
-#include "render/gpu_frame_renderer.h"
-#include "render/gpu_pick.h"
-#include "render/gpu_scene_table.h"
-#include "render/gpu_tractogram_upload.h"
+#include "render/gpu/fiber_attributes.h"
+#include "render/gpu/frame_renderer.h"
+#include "render/gpu/pick.h"
+#include "render/gpu/scene_table.h"
+#include "render/gpu/tractogram_upload.h"
 #include "render/image_compare.h"
 #include "render/reference_raster.h"
 #include "shared/render_config.h"

@@ -13,9 +13,9 @@
 #include "gpu_render_test_support.h"
 #include "gpu_test_context.h"
 #include "render/camera.h"
-#include "render/gpu_frame_renderer.h"
-#include "render/gpu_pick.h"
-#include "render/gpu_tractogram_upload.h"
+#include "render/gpu/frame_renderer.h"
+#include "render/gpu/pick.h"
+#include "render/gpu/tractogram_upload.h"
 #include "render/reference_raster.h"
 #include "shared/render_config.h"
 

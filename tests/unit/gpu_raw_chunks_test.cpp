@@ -1,5 +1,5 @@
 // The raw tractogram's points split into chunks of whole streamlines
-// (render/gpu_raw_tractogram.h), forced tiny here so that a few-hundred
+// (render/gpu/raw_tractogram.h), forced tiny here so that a few-hundred
 // fiber phantom spans many of them: the chunk plan, every byte of every
 // chunk, G-buffers bit for bit the same as from one chunk for both baseline
 // pipelines, raw-compute still on the CPU reference, and the one-line
@@ -16,8 +16,8 @@
 #include "gpu_render_test_support.h"
 #include "gpu_test_context.h"
 #include "render/camera.h"
-#include "render/gpu_frame_renderer.h"
-#include "render/gpu_raw_tractogram.h"
+#include "render/gpu/frame_renderer.h"
+#include "render/gpu/raw_tractogram.h"
 #include "render/image_compare.h"
 #include "render/reference_raster.h"
 #include "shared/render_config.h"

@@ -1,4 +1,4 @@
-// The shading stages (src/render/gpu_shading_stages.h) on hand-made G-buffers,
+// The shading stages (src/render/gpu/shading_stages.h) on hand-made G-buffers,
 // checked against CPU computations of the same formulas written
 // independently of the shaders (world position from the inverse of the
 // double-precision view-projection, light from the camera's look-at frame),
@@ -16,16 +16,16 @@
 
 #include "core/error.h"
 #include "gpu/submit.h"
+#include "gpu_given_gbuffer_stage.h"
 #include "gpu_test_context.h"
 #include "io/reader.h"
 #include "phantom/phantom.h"
 #include "render/camera.h"
 #include "render/colormap.h"
-#include "render/gpu_fiber_attributes.h"
-#include "render/gpu_frame_renderer.h"
-#include "gpu_given_gbuffer_stage.h"
-#include "render/gpu_shading_stages.h"
-#include "render/gpu_tractogram_upload.h"
+#include "render/gpu/fiber_attributes.h"
+#include "render/gpu/frame_renderer.h"
+#include "render/gpu/shading_stages.h"
+#include "render/gpu/tractogram_upload.h"
 #include "render/reference_raster.h"
 #include "shared/gbuffer.h"
 #include "shared/render_config.h"

@@ -1,4 +1,4 @@
-// Uploads into device buffers (render/gpu_staged_upload.h): through a
+// Uploads into device buffers (render/gpu/staged_upload.h): through a
 // small staging buffer in many chunks, and in place where the device shares
 // the host's memory (lavapipe here), with the range spread over threads.
 // Either way the buffer must hold the source's bytes exactly, every byte
@@ -13,7 +13,7 @@
 
 #include "core/thread_pool.h"
 #include "gpu_test_context.h"
-#include "render/gpu_staged_upload.h"
+#include "render/gpu/staged_upload.h"
 
 namespace fibscope {
 namespace {

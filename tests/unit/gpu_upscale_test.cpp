@@ -11,7 +11,7 @@
 
 #include "gpu/submit.h"
 #include "gpu_test_context.h"
-#include "render/gpu_upscale_pass.h"
+#include "render/gpu/upscale_pass.h"
 
 namespace fibscope {
 namespace {

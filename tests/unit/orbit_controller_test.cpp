@@ -1,4 +1,4 @@
-#include "render/orbit_controller.h"
+#include "app/viewer/orbit_controller.h"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
-// The PNG writer (src/render/png_writer.h): the file's structure, and
+// The PNG writer (src/io/png_writer.h): the file's structure, and
 // zlib (an independent decoder) reading back what the banded, multi-threaded
 // compression wrote.
-#include "render/png_writer.h"
+#include "io/png_writer.h"
 
 #include <gtest/gtest.h>
 

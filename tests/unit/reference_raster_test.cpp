@@ -13,11 +13,11 @@
 #include <vector>
 
 #include "core/error.h"
+#include "io/png_writer.h"
 #include "io/reader.h"
 #include "phantom/phantom.h"
 #include "render/camera.h"
 #include "render/image_compare.h"
-#include "render/png_writer.h"
 #include "render/reference_raster.h"
 #include "shared/camera.h"
 #include "shared/render_config.h"

@@ -18,6 +18,7 @@
 #include "app/open_input.h"
 #include "app/viewer/adaptive_detail.h"
 #include "app/viewer/imgui_layer.h"
+#include "app/viewer/orbit_controller.h"
 #include "app/viewer/presentation.h"
 #include "app/viewer/recent_files.h"
 #include "app/viewer/viewer_input.h"
@@ -31,16 +32,15 @@
 #include "gpu/submit.h"
 #include "gpu/swapchain.h"
 #include "gpu/vk_check.h"
+#include "io/png_writer.h"
 #include "phantom/phantom.h"
-#include "render/gpu_dataset.h"
-#include "render/gpu_frame_renderer.h"
 #include "render/colormap.h"
-#include "render/gpu_pick.h"
-#include "render/gpu_raw_tractogram.h"
-#include "render/gpu_scene_table.h"
-#include "render/gpu_upscale_pass.h"
-#include "render/orbit_controller.h"
-#include "render/png_writer.h"
+#include "render/gpu/dataset.h"
+#include "render/gpu/frame_renderer.h"
+#include "render/gpu/pick.h"
+#include "render/gpu/raw_tractogram.h"
+#include "render/gpu/scene_table.h"
+#include "render/gpu/upscale_pass.h"
 
 namespace fibscope {
 namespace {
@@ -59,7 +59,7 @@ struct ViewerModel {
 };
 
 // What the next frame draws: every visible model's fiblets in one scene
-// (scene-global fiber ids, render/gpu_scene_table.h), or a baseline
+// (scene-global fiber ids, render/gpu/scene_table.h), or a baseline
 // pipeline's raw vertices of the active model alone.
 struct FrameScene {
   std::vector<int> models;  // the drawn models (indices into the list), in the scene's order

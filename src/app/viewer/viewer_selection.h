@@ -5,7 +5,7 @@
 // selection panel, and the export of the selection to a .tck.
 //
 // Several models are drawn in one frame with scene-global fiber ids
-// (render/gpu_scene_table.h), so a selection entry names its model by the
+// (render/gpu/scene_table.h), so a selection entry names its model by the
 // viewer's model id (unique per load: a reloaded file is a new model) and
 // the fiber within it. A closed model takes its entries with it; a hidden
 // one keeps them (not highlighted while hidden). Every call that touches
@@ -24,8 +24,8 @@
 #include "app/viewer/viewer_state.h"
 #include "codec/fbl_file.h"
 #include "gpu/vulkan_context.h"
-#include "render/gpu_dataset.h"
-#include "render/gpu_fiber_attributes.h"
+#include "render/gpu/dataset.h"
+#include "render/gpu/fiber_attributes.h"
 
 namespace fibscope {
 

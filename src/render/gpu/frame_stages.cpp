@@ -1,0 +1,22 @@
+#include "render/gpu/frame_stages.h"
+
+namespace fibscope {
+
+FrameStageList shadingStages() { return {makeTilesStage, makeSsaoStage, makeShadeStage, makeFxaaStage}; }
+
+FrameStageList standardFrameStages() {
+  FrameStageList list = {
+      makeSetupStage,
+      // Geometry: the lines' G-buffer (one of them runs).
+      makeFibletStage,
+      makeRawComputeStage,
+      makeLinesStage,
+      // Surfaces into the surface target, then merged by depth.
+      makeSphereStage,
+      makeSurfaceMergeStage,
+  };
+  for (FrameStageFactory& f : shadingStages()) list.push_back(std::move(f));
+  return list;
+}
+
+}  // namespace fibscope

@@ -1,0 +1,40 @@
+// The stages of a frame (frame_stage.h), one factory each, and the
+// standard list FrameRenderer runs. Each stage lives in its own file
+// (gpu_<name>_stage.cpp) with the passes it records.
+#pragma once
+
+#include "render/gpu/frame_stage.h"
+
+namespace fibscope {
+
+// "clear": the camera block and the scene table written, the visibility
+// buffer cleared (not for lines, which have their own depth attachment),
+// the surface target cleared in a frame with surfaces.
+std::unique_ptr<FrameStage> makeSetupStage(const gpu::VulkanContext& context);
+// Geometry, one per frame by settings.pipeline:
+// "fiblet bounds", "cull"/"raster" (or the two-phase passes), "resolve":
+// the compute pipeline over the scene's datasets (cull_passes.h,
+// fiblet_passes.h).
+std::unique_ptr<FrameStage> makeFibletStage(const gpu::VulkanContext& context);
+// "raster", "resolve": the raw-compute baseline (raw_passes.h).
+std::unique_ptr<FrameStage> makeRawComputeStage(const gpu::VulkanContext& context);
+// "lines": the graphics-pipeline baseline (lines_pass.h; its pipeline
+// made at the first lines frame: compute-only devices never need it).
+std::unique_ptr<FrameStage> makeLinesStage(const gpu::VulkanContext& context);
+// Surfaces: "spheres", GpuScene::spheres ray-cast (sphere_surface.comp).
+std::unique_ptr<FrameStage> makeSphereStage(const gpu::VulkanContext& context);
+// "surface merge": the surface target into the G-buffer (surface_merge.comp).
+std::unique_ptr<FrameStage> makeSurfaceMergeStage(const gpu::VulkanContext& context);
+// Shading (shading_stages.h).
+std::unique_ptr<FrameStage> makeTilesStage(const gpu::VulkanContext& context);
+std::unique_ptr<FrameStage> makeSsaoStage(const gpu::VulkanContext& context);
+std::unique_ptr<FrameStage> makeShadeStage(const gpu::VulkanContext& context);
+std::unique_ptr<FrameStage> makeFxaaStage(const gpu::VulkanContext& context);
+
+// tiles, ssao, shade, fxaa: the G-buffer (and surface target) -> RGBA8.
+FrameStageList shadingStages();
+// Everything a frame of any pipeline needs, in order: setup, the three
+// geometry stages, the surface stages, merge, shading.
+FrameStageList standardFrameStages();
+
+}  // namespace fibscope

@@ -1,0 +1,53 @@
+// The frame's first stage: what every later pass reads from the frame's
+// start (the camera block, the compute pipeline's scene table) and the
+// targets that passes accumulate into (the visibility buffer, the surface
+// target), in one timed "clear" pass.
+#include <bit>
+
+#include "gpu/buffer.h"
+#include "gpu/pass_scope.h"
+#include "render/gpu/frame_stages.h"
+
+namespace fibscope {
+namespace {
+
+class SetupStage final : public FrameStage {
+ public:
+  explicit SetupStage(const gpu::VulkanContext& context) : scene_table_(createSceneTableBuffer(context)) {}
+  void destroy(const gpu::VulkanContext& context) override { gpu::destroyBuffer(context, scene_table_); }
+  uint32_t maxPasses() const override { return 1; }
+  bool runs(const FrameContext&) const override { return true; }
+
+  void record(FrameContext& frame) override {
+    const bool lines = frame.settings.pipeline == RenderPipeline::Lines;
+    // Everything after reads or accumulates into these: compute passes,
+    // and the lines pipeline's vertex shader (the camera block).
+    const gpu::PassBarrier after{VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                 VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT,
+                                 gpu::kStorageReadWrite};
+    gpu::PassScope pass(frame.cmd, frame.timer, "clear", after);
+    const shader::CameraBlock block = makeCameraBlock(frame.camera, frame.settings.line_width_px);
+    vkCmdUpdateBuffer(frame.cmd, frame.targets.camera.buffer, 0, sizeof(block), &block);
+    if (frame.settings.pipeline == RenderPipeline::Compute) {
+      const std::vector<uint32_t> words = sceneTableWords(frame.layout);
+      vkCmdUpdateBuffer(frame.cmd, scene_table_.buffer, 0, words.size() * sizeof(uint32_t), words.data());
+      frame.scene_table = scene_table_.address;
+    }
+    if (!lines) vkCmdFillBuffer(frame.cmd, frame.targets.visibility.buffer, 0, VK_WHOLE_SIZE, 0xFFFFFFFFu);
+    // Every word 1.0f: depth 1, which no surface pass and no merge takes
+    // (shared/gbuffer.h: SurfaceTexel).
+    if (frame.surfaces)
+      vkCmdFillBuffer(frame.cmd, frame.targets.surface.buffer, 0, VK_WHOLE_SIZE, std::bit_cast<uint32_t>(1.0f));
+  }
+
+ private:
+  gpu::Buffer scene_table_;  // shared/scene_table.h
+};
+
+}  // namespace
+
+std::unique_ptr<FrameStage> makeSetupStage(const gpu::VulkanContext& context) {
+  return std::make_unique<SetupStage>(context);
+}
+
+}  // namespace fibscope
