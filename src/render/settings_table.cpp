@@ -23,14 +23,19 @@ void setChoice(RenderSettings& s, int v) {
   s.*member = Enum(v);
 }
 
-SettingInfo choice(std::string_view name, std::string_view label, std::string_view help, int count,
-                   std::string_view (*name_of)(int), int (*get)(const RenderSettings&),
-                   void (*set)(RenderSettings&, int)) {
+SettingInfo entry(std::string_view name, std::string_view label, std::string_view help, SettingKind kind) {
   SettingInfo i;
   i.name = name;
   i.label = label;
   i.help = help;
-  i.kind = SettingKind::Choice;
+  i.kind = kind;
+  return i;
+}
+
+SettingInfo choice(std::string_view name, std::string_view label, std::string_view help, int count,
+                   std::string_view (*name_of)(int), int (*get)(const RenderSettings&),
+                   void (*set)(RenderSettings&, int)) {
+  SettingInfo i = entry(name, label, help, SettingKind::Choice);
   i.choice_count = count;
   i.choice_name = name_of;
   i.get_choice = get;
@@ -40,11 +45,7 @@ SettingInfo choice(std::string_view name, std::string_view label, std::string_vi
 
 SettingInfo number(std::string_view name, std::string_view label, std::string_view help, float RenderSettings::*m,
                    double lo, double hi, std::string_view unit = {}) {
-  SettingInfo i;
-  i.name = name;
-  i.label = label;
-  i.help = help;
-  i.kind = SettingKind::Number;
+  SettingInfo i = entry(name, label, help, SettingKind::Number);
   i.number = m;
   i.min = lo;
   i.max = hi;
@@ -53,22 +54,14 @@ SettingInfo number(std::string_view name, std::string_view label, std::string_vi
 }
 
 SettingInfo flag(std::string_view name, std::string_view label, std::string_view help, bool RenderSettings::*m) {
-  SettingInfo i;
-  i.name = name;
-  i.label = label;
-  i.help = help;
-  i.kind = SettingKind::Flag;
+  SettingInfo i = entry(name, label, help, SettingKind::Flag);
   i.flag = m;
   return i;
 }
 
 SettingInfo color(std::string_view name, std::string_view label, std::string_view help,
                   std::array<float, 3> RenderSettings::*m) {
-  SettingInfo i;
-  i.name = name;
-  i.label = label;
-  i.help = help;
-  i.kind = SettingKind::Color;
+  SettingInfo i = entry(name, label, help, SettingKind::Color);
   i.color = m;
   i.min = 0;
   i.max = 1;
@@ -119,11 +112,8 @@ std::vector<SettingInfo> makeTable() {
                           getChoice<Colormap, &RenderSettings::colormap>,
                           setChoice<Colormap, &RenderSettings::colormap>),
                    isScalar));
-  SettingInfo range;
-  range.name = "scalar-range";
-  range.label = "range";
-  range.help = "MIN,MAX mapped onto the colormap (default: the data's range)";
-  range.kind = SettingKind::Range;
+  SettingInfo range = entry("scalar-range", "range", "MIN,MAX mapped onto the colormap (default: the data's range)",
+                            SettingKind::Range);
   range.number = &RenderSettings::scalar_min;
   range.number_max = &RenderSettings::scalar_max;
   range.min = -1e30;
@@ -155,11 +145,8 @@ std::vector<SettingInfo> makeTable() {
   t.push_back(with(number("ssao-strength", "AO strength", "How dark full occlusion gets (0 to 1)",
                           &RenderSettings::ssao_strength, 0, 1),
                    hasSsao));
-  SettingInfo scales;
-  scales.name = "ao-scales";
-  scales.label = "AO scales";
-  scales.help = "Multi-scale AO: 1 to 4 radii (r, 2r, 4r, 8r)";
-  scales.kind = SettingKind::Integer;
+  SettingInfo scales = entry("ao-scales", "AO scales", "Multi-scale AO: 1 to 4 radii (r, 2r, 4r, 8r)",
+                             SettingKind::Integer);
   scales.integer = &RenderSettings::ao_scales;
   scales.min = 1;
   scales.max = shader::kSsaoMaxScales;
@@ -191,14 +178,14 @@ bool parseList(std::string_view text, double* out, int n) {
   return true;
 }
 
-std::string number(double v) {
+std::string formatNumber(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%g", v);
   return buf;
 }
 
 std::string withUnit(const SettingInfo& info, double lo, double hi) {
-  return number(lo) + " to " + number(hi) + (info.unit.empty() ? "" : " " + std::string(info.unit));
+  return formatNumber(lo) + " to " + formatNumber(hi) + (info.unit.empty() ? "" : " " + std::string(info.unit));
 }
 
 bool inRange(const SettingInfo& info, double v) { return v >= info.min && v <= info.max; }  // false for NaN
@@ -282,13 +269,13 @@ std::string settingText(const RenderSettings& s, const SettingInfo& info) {
   switch (info.kind) {
     case SettingKind::Flag: return s.*info.flag ? "on" : "off";
     case SettingKind::Integer: return std::to_string(s.*info.integer);
-    case SettingKind::Number: return number(s.*info.number);
+    case SettingKind::Number: return formatNumber(s.*info.number);
     case SettingKind::Choice: return std::string(info.choice_name(info.get_choice(s)));
     case SettingKind::Color: {
       const std::array<float, 3>& c = s.*info.color;
-      return number(c[0]) + "," + number(c[1]) + "," + number(c[2]);
+      return formatNumber(c[0]) + "," + formatNumber(c[1]) + "," + formatNumber(c[2]);
     }
-    case SettingKind::Range: return number(s.*info.number) + "," + number(s.*info.number_max);
+    case SettingKind::Range: return formatNumber(s.*info.number) + "," + formatNumber(s.*info.number_max);
   }
   return {};
 }

@@ -11,6 +11,7 @@
 #include <random>
 #include <sstream>
 
+#include "core/error.h"
 #include "io/reader.h"
 #include "io/writer.h"
 #include "phantom/phantom.h"
@@ -105,6 +106,15 @@ std::string writePhantomTck(const TempDir& dir, const std::string& name, uint64_
   const std::string path = dir.file(name);
   writeTractogram(path, all, TractogramHeader{});
   return path;
+}
+
+std::string errorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return {};
 }
 
 }  // namespace fibscope::test

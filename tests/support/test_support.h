@@ -2,6 +2,7 @@
 // executable and helper scripts, small synthetic tractograms.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -47,5 +48,8 @@ Tractogram smallTractogram(size_t streamlines, unsigned seed = 1, bool with_data
 // The built-in phantom's first `streamlines` fibers (one thread, `seed`)
 // written as dir/name in .tck, without per-streamline data; returns the path.
 std::string writePhantomTck(const TempDir& dir, const std::string& name, uint64_t streamlines, uint64_t seed);
+
+// The message of the Error `f` throws; empty when it throws none.
+std::string errorOf(const std::function<void()>& f);
 
 }  // namespace fibscope::test

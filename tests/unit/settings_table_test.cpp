@@ -29,14 +29,6 @@ std::string pastTheRange(const SettingInfo& info) {
   return {};
 }
 
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return {};
-}
 
 TEST(SettingsTable, namesAreUniqueAndEveryEntryIsComplete) {
   std::set<std::string> names;
@@ -86,7 +78,7 @@ TEST(SettingsTable, theScriptAndTheValidationRejectWhatIsOutOfRangeWithTheRange)
     const std::string bad = pastTheRange(info);
     RenderSettings s;
     const std::string before = settingText(s, info);
-    const std::string script = errorOf([&] { applySetting(s, info.name, bad); });
+    const std::string script = test::errorOf([&] { applySetting(s, info.name, bad); });
     EXPECT_NE(script.find("set " + std::string(info.name) + ": expected " + expectation), std::string::npos) << script;
     EXPECT_EQ(settingText(s, info), before) << "a rejected value changed the setting";
     // The renderer's check, on a value the program set without parsing.
@@ -102,10 +94,10 @@ TEST(SettingsTable, theScriptAndTheValidationRejectWhatIsOutOfRangeWithTheRange)
       case SettingKind::Choice: info.set_choice(direct, info.choice_count); break;
       case SettingKind::Flag: continue;  // every bool is valid
     }
-    const std::string check = errorOf([&] { validateRenderSettings(direct); });
+    const std::string check = test::errorOf([&] { validateRenderSettings(direct); });
     EXPECT_NE(check.find(std::string(info.label) + " must be " + expectation), std::string::npos) << check;
   }
-  EXPECT_NE(errorOf([] {
+  EXPECT_NE(test::errorOf([] {
               RenderSettings s;
               applySetting(s, "speed", "3");
             }).find("unknown setting 'speed'"),

@@ -66,18 +66,8 @@ Tractogram readChunked(const std::string& path, size_t max_points, TractogramHea
   return all;
 }
 
-// The message of the Error `f` throws, "" when it throws none.
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return {};
-}
-
 std::string readError(const std::string& path) {
-  return errorOf([&] { readChunked(path, 5); });
+  return test::errorOf([&] { readChunked(path, 5); });
 }
 
 void expectOneLineError(const std::string& message, const std::string& path, const std::string& needle) {
@@ -551,7 +541,7 @@ TEST(TrxWriter, refusesToOverwriteUnlessAsked) {
   const Tractogram t = test::smallTractogram(5);
   const std::string path = dir.file("exists.trx");
   test::writeBytes(path, "keep me");
-  const std::string message = errorOf([&] { writeTractogram(path, t, likeFor(t)); });
+  const std::string message = test::errorOf([&] { writeTractogram(path, t, likeFor(t)); });
   expectOneLineError(message, path, "exists");
   EXPECT_EQ(test::readBytes(path), "keep me");
   EXPECT_EQ(listDirectory(dir.path()).size(), 1u);
@@ -583,19 +573,19 @@ TEST(TrxWriter, leavesNothingBehindWhenAbandonedOrFailing) {
   TractogramHeader like = likeFor(t);
   like.groups.push_back({"too_far", {1, 9}});
   const std::string path = dir.file("bad_group.trx");
-  expectOneLineError(errorOf([&] { writeTractogram(path, t, like); }), path, "streamline 9");
+  expectOneLineError(test::errorOf([&] { writeTractogram(path, t, like); }), path, "streamline 9");
   EXPECT_TRUE(listDirectory(dir.path()).empty());
 
   like = likeFor(t);
   like.per_point[0].name = "../escape";
-  expectOneLineError(errorOf([&] { writeTractogram(path, t, like); }), path, "../escape");
+  expectOneLineError(test::errorOf([&] { writeTractogram(path, t, like); }), path, "../escape");
   Tractogram huge = t;
   huge.positions[4] = 70000.0f;
   WriterOptions options;
   options.trx_position_dtype = "float16";
-  expectOneLineError(errorOf([&] { writeTractogram(path, huge, likeFor(t), options); }), path, "float16");
+  expectOneLineError(test::errorOf([&] { writeTractogram(path, huge, likeFor(t), options); }), path, "float16");
   options.trx_position_dtype = "float8";
-  expectOneLineError(errorOf([&] { writeTractogram(path, t, likeFor(t), options); }), path, "float8");
+  expectOneLineError(test::errorOf([&] { writeTractogram(path, t, likeFor(t), options); }), path, "float8");
   EXPECT_TRUE(listDirectory(dir.path()).empty());
 }
 

@@ -66,12 +66,12 @@ void FrameRenderer::record(VkCommandBuffer cmd, const Camera& camera, const Rend
   FrameContext frame{cmd, context_, camera, settings, scene, targets_, &timer_, pending_, layout_};
   // Per-fiber attributes cover the fibers of the tractogram drawn.
   frame.fiber_count = compute ? layout_.fibers : scene.raw->streamlineCount();
+  // Surfaces first (whether a surface stage runs does not depend on it),
+  // then the stages this frame runs, each told whether there are surfaces.
+  for (auto& stage : stages_) frame.surfaces |= stage->drawsSurfaces() && stage->runs(frame);
   ran_.clear();
-  for (auto& stage : stages_) {
-    if (!stage->runs(frame)) continue;
-    ran_.push_back(stage.get());
-    frame.surfaces |= stage->drawsSurfaces();
-  }
+  for (auto& stage : stages_)
+    if (stage->runs(frame)) ran_.push_back(stage.get());
   for (FrameStage* stage : ran_) stage->check(frame);
   if (frame.surfaces) ensureSurfaceTarget(context_, targets_);
 
