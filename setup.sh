@@ -47,7 +47,13 @@ configure() {  # configure DIR [cmake args...] unless already configured
 }
 
 configure build -DCMAKE_BUILD_TYPE=RelWithDebInfo
-ninja -C build -j "$jobs" --quiet
+if [ "$mode" = run ]; then
+  # The main job needs the program only; the tests and benchmarks are built
+  # by `./setup.sh test`.
+  ninja -C build -j "$jobs" --quiet fibscope
+else
+  ninja -C build -j "$jobs" --quiet
+fi
 
 if [ "$mode" = run ]; then
   mkdir -p out

@@ -5,8 +5,11 @@
 
 #include "app/commands.h"
 #include "core/error.h"
+#include "core/interrupt_cleanup.h"
 
 int main(int argc, char** argv) {
+  // Before any thread: an interrupted command removes its temporary outputs.
+  fibscope::installInterruptCleanup();
   CLI::App app{"fibscope: real-time whole-brain tractogram viewer and tools"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "fibscope 0.1.0");

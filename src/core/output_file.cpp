@@ -10,6 +10,7 @@
 #include <filesystem>
 
 #include "core/error.h"
+#include "core/interrupt_cleanup.h"
 
 namespace fibscope {
 namespace {
@@ -42,14 +43,21 @@ OutputFile::OutputFile(const std::string& path, bool overwrite) : path_(path) {
   const std::string dir = p.has_parent_path() ? p.parent_path().string() + "/" : std::string();
   temp_path_ = dir + "." + p.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
                std::to_string(counter++);
+  registerTemporaryPath(temp_path_);  // removed if the process is interrupted
   fd_ = ::open(temp_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd_ < 0) failErrno(path, "cannot create output file");
+  if (fd_ < 0) {
+    unregisterTemporaryPath(temp_path_);
+    failErrno(path, "cannot create output file");
+  }
   buffer_.reserve(kBufferBytes);
 }
 
 OutputFile::~OutputFile() {
   if (fd_ >= 0) ::close(fd_);
-  if (!committed_) ::unlink(temp_path_.c_str());
+  if (!committed_) {
+    ::unlink(temp_path_.c_str());
+    unregisterTemporaryPath(temp_path_);
+  }
 }
 
 void OutputFile::write(const void* data, size_t bytes) {
@@ -106,6 +114,7 @@ void OutputFile::commit() {
   fd_ = -1;
   if (::rename(temp_path_.c_str(), path_.c_str()) != 0) failErrno(path_, "cannot rename temporary file into place");
   committed_ = true;
+  unregisterTemporaryPath(temp_path_);
 }
 
 }  // namespace fibscope

@@ -25,6 +25,7 @@
 
 #include "core/byte_order.h"
 #include "core/error.h"
+#include "core/interrupt_cleanup.h"
 #include "core/output_file.h"
 #include "io/trx_format.h"
 #include "io/writer.h"
@@ -47,10 +48,13 @@ std::string hiddenSibling(const std::string& path, const std::string& tag) {
 class ScopedPath {
  public:
   ScopedPath() = default;
-  explicit ScopedPath(std::string path) : path_(std::move(path)) {}
+  // Register before creating the path (core/interrupt_cleanup.h).
+  explicit ScopedPath(std::string path) : path_(std::move(path)) { registerTemporaryPath(path_); }
   ~ScopedPath() {
     std::error_code ec;
-    if (!path_.empty()) fs::remove_all(path_, ec);
+    if (path_.empty()) return;
+    fs::remove_all(path_, ec);
+    unregisterTemporaryPath(path_);
   }
   ScopedPath(const ScopedPath&) = delete;
   ScopedPath& operator=(const ScopedPath&) = delete;
@@ -59,7 +63,11 @@ class ScopedPath {
     return *this;
   }
   const std::string& path() const { return path_; }
-  void release() { path_.clear(); }
+  // The path was renamed into place: nothing to remove any more.
+  void release() {
+    if (!path_.empty()) unregisterTemporaryPath(path_);
+    path_.clear();
+  }
 
  private:
   std::string path_;
@@ -157,8 +165,12 @@ TrxWriter::TrxWriter(const std::string& path, const TractogramHeader& like, cons
   position_dtype_ = *dtype;
 
   const std::string temp = hiddenSibling(path_, "tmpdir");
-  if (::mkdir(temp.c_str(), 0755) != 0) failErrno(path_, "cannot create temporary directory " + temp);
-  temp_ = ScopedPath(temp);
+  ScopedPath dir(temp);
+  if (::mkdir(temp.c_str(), 0755) != 0) {
+    dir.release();  // not ours to remove
+    failErrno(path_, "cannot create temporary directory " + temp);
+  }
+  temp_ = std::move(dir);
 
   offsets_ = createMember("offsets.uint64");
   positions_ = createMember(trx::memberFileName("positions", 3, position_dtype_));
