@@ -192,16 +192,30 @@ Camera snugCamera(std::span<const Vec3d> points, const std::function<Camera(doub
   return make(hi);
 }
 
-std::vector<Vec3d> samplePoints(const Tractogram& tractogram, size_t count) {
-  std::vector<Vec3d> sample;
-  const size_t n = tractogram.pointCount();
-  if (n == 0 || count == 0) return sample;
-  const size_t stride = std::max<size_t>(1, n / count);
-  for (size_t i = 0; i < n; i += stride) {
-    const float* p = tractogram.point(i);
-    if (std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2])) sample.push_back({p[0], p[1], p[2]});
+void PointSample::add(const Tractogram& chunk) {
+  for (size_t i = 0; i < chunk.pointCount(); ++i, ++seen_) {
+    if (seen_ % stride_ != 0) continue;
+    const float* p = chunk.point(i);
+    if (!(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]))) continue;
+    kept_.push_back({seen_, {p[0], p[1], p[2]}});
+    if (kept_.size() > limit_) {
+      stride_ *= 2;
+      std::erase_if(kept_, [&](const auto& k) { return k.first % stride_ != 0; });
+    }
   }
-  return sample;
+}
+
+std::vector<Vec3d> PointSample::points() const {
+  std::vector<Vec3d> out;
+  out.reserve(kept_.size());
+  for (const auto& k : kept_) out.push_back(k.second);
+  return out;
+}
+
+std::vector<Vec3d> samplePoints(const Tractogram& tractogram, size_t count) {
+  PointSample sample(2 * count);
+  sample.add(tractogram);
+  return sample.points();
 }
 
 }  // namespace fibscope

@@ -105,8 +105,27 @@ Camera standardView(const Bounds& bounds, StandardView view, uint32_t width, uin
 // centre in normalised device coordinates (0.9: a 5 % border each side).
 Camera snugCamera(std::span<const Vec3d> points, const std::function<Camera(double factor)>& make,
                   double margin = 0.9);
-// About `count` points of the tractogram, evenly spaced along its points
-// (for snugCamera).
+// A sample of a stream of points, to frame a view (snugCamera): every
+// stride-th point (by index over the whole stream; non-finite ones left
+// out), the stride doubling whenever more than `limit` are kept. The same
+// points give the same sample however they arrive in chunks, so a file
+// read once in chunks (render's streamed upload) and read whole (the
+// baselines, the viewer) frame the same picture.
+class PointSample {
+ public:
+  explicit PointSample(size_t limit = 8192) : limit_(limit < 2 ? 2 : limit) {}
+  void add(const Tractogram& chunk);
+  // Between limit / 2 and limit points once there are that many.
+  std::vector<Vec3d> points() const;
+
+ private:
+  size_t limit_;
+  uint64_t stride_ = 1, seen_ = 0;
+  std::vector<std::pair<uint64_t, Vec3d>> kept_;  // (index in the stream, point)
+};
+
+// PointSample of the whole tractogram with limit 2 * count: about `count`
+// to 2 * count of its points.
 std::vector<Vec3d> samplePoints(const Tractogram& tractogram, size_t count = 4096);
 
 }  // namespace fibscope

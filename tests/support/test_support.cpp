@@ -2,6 +2,7 @@
 
 #include <sys/wait.h>
 #include <unistd.h>
+#include <zlib.h>
 
 #include <cmath>
 #include <cstdio>
@@ -116,5 +117,45 @@ std::string errorOf(const std::function<void()>& f) {
   }
   return {};
 }
+
+Png readOurPng(const std::string& path) {
+  const std::string bytes = test::readBytes(path);
+  Png png;
+  if (bytes.size() < 8 || bytes.compare(0, 8, "\x89PNG\r\n\x1a\n") != 0) return png;
+  auto be32 = [&](size_t at) {
+    return uint32_t(uint8_t(bytes[at])) << 24 | uint32_t(uint8_t(bytes[at + 1])) << 16 |
+           uint32_t(uint8_t(bytes[at + 2])) << 8 | uint32_t(uint8_t(bytes[at + 3]));
+  };
+  std::string idat;
+  uint32_t w = 0, h = 0;
+  for (size_t at = 8; at + 12 <= bytes.size();) {
+    const uint32_t length = be32(at);
+    const std::string type = bytes.substr(at + 4, 4);
+    if (at + 12 + length > bytes.size()) return png;
+    if (type == "IHDR") {
+      w = be32(at + 8);
+      h = be32(at + 12);
+      if (bytes[at + 16] != 8 || bytes[at + 17] != 6) return png;
+    }
+    if (type == "IDAT") idat += bytes.substr(at + 8, length);
+    at += 12 + length;
+  }
+  std::vector<uint8_t> raw(size_t(h) * (1 + size_t(w) * 4));
+  uLongf raw_size = uLongf(raw.size());
+  if (w == 0 || uncompress(raw.data(), &raw_size, reinterpret_cast<const Bytef*>(idat.data()), uLong(idat.size())) !=
+                    Z_OK ||
+      raw_size != raw.size())
+    return png;
+  png.rgba.reserve(size_t(w) * h * 4);
+  for (uint32_t y = 0; y < h; ++y) {
+    const uint8_t* row = &raw[size_t(y) * (1 + size_t(w) * 4)];
+    if (row[0] != 0) return Png{};
+    png.rgba.insert(png.rgba.end(), row + 1, row + 1 + size_t(w) * 4);
+  }
+  png.width = w;
+  png.height = h;
+  return png;
+}
+
 
 }  // namespace fibscope::test

@@ -2,6 +2,7 @@
 // executable and helper scripts, small synthetic tractograms.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -51,5 +52,15 @@ std::string writePhantomTck(const TempDir& dir, const std::string& name, uint64_
 
 // The message of the Error `f` throws; empty when it throws none.
 std::string errorOf(const std::function<void()>& f);
+
+// An 8-bit RGBA image read from a PNG.
+struct Png {
+  uint32_t width = 0, height = 0;
+  std::vector<uint8_t> rgba;
+  const uint8_t* at(uint32_t x, uint32_t y) const { return &rgba[(size_t(y) * width + x) * 4]; }
+};
+// Decodes the PNGs writePngRgba writes (8-bit RGBA, filter 0 on every row);
+// anything else gives an empty image (a test failure where one is read).
+Png readOurPng(const std::string& path);
 
 }  // namespace fibscope::test

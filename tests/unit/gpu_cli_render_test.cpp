@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -68,6 +69,34 @@ TEST_F(GpuCliRender, renderReadsAFileWithEveryColourAndCamera) {
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_EQ(pngSize(png), std::make_pair(96u, 64u));
   }
+}
+
+// The box of the pixels that are not the background (black): x0, y0, x1, y1.
+std::array<uint32_t, 4> litBox(const test::Png& png) {
+  std::array<uint32_t, 4> box = {png.width, png.height, 0, 0};
+  for (uint32_t y = 0; y < png.height; ++y)
+    for (uint32_t x = 0; x < png.width; ++x) {
+      const uint8_t* p = png.at(x, y);
+      if (p[0] + p[1] + p[2] == 0) continue;
+      box = {std::min(box[0], x), std::min(box[1], y), std::max(box[2], x + 1), std::max(box[3], y + 1)};
+    }
+  return box;
+}
+
+TEST_F(GpuCliRender, everyPipelineFramesTheSamePictureOfAFile) {
+  // The compute pipeline streams the file, the baselines read it whole:
+  // both frame the view from the same sample of its points (PointSample).
+  const std::string tck = dir_.file("in.tck");
+  ASSERT_EQ(test::runFibscope("phantom " + tck + " -n 400 --seed 4").exit_code, 0);
+  std::vector<std::array<uint32_t, 4>> boxes;
+  for (const std::string pipeline : {"compute", "raw-compute"}) {
+    const std::string png = dir_.file(pipeline + ".png");
+    const auto r = runGpuFibscope("render --validate --size 640x480 --view coronal --no-ssao --pipeline " + pipeline +
+                                  " " + tck + " -o " + png);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    boxes.push_back(litBox(test::readOurPng(png)));
+  }
+  for (int k = 0; k < 4; ++k) EXPECT_NEAR(double(boxes[0][k]), double(boxes[1][k]), 1.0) << "edge " << k;
 }
 
 TEST_F(GpuCliRender, badOptionsAreOneLineErrors) {

@@ -4,7 +4,6 @@
 // one-line errors for malformed scripts. The script parser and the input
 // mapping are pure and tested without a GPU.
 #include <gtest/gtest.h>
-#include <zlib.h>
 
 #include <GLFW/glfw3.h>
 
@@ -286,52 +285,8 @@ TEST(ViewerInput, keysSelectStandardViewsResetAndScreenshot) {
 
 // --- the viewer (Vulkan) ---------------------------------------------------
 
-struct Png {
-  uint32_t width = 0, height = 0;
-  std::vector<uint8_t> rgba;
-  const uint8_t* at(uint32_t x, uint32_t y) const { return &rgba[(size_t(y) * width + x) * 4]; }
-};
-
-// Decodes the PNGs writePngRgba writes (8-bit RGBA, filter 0 on every row);
-// anything else is a test failure (empty result).
-Png readOurPng(const std::string& path) {
-  const std::string bytes = test::readBytes(path);
-  Png png;
-  if (bytes.size() < 8 || bytes.compare(0, 8, "\x89PNG\r\n\x1a\n") != 0) return png;
-  auto be32 = [&](size_t at) {
-    return uint32_t(uint8_t(bytes[at])) << 24 | uint32_t(uint8_t(bytes[at + 1])) << 16 |
-           uint32_t(uint8_t(bytes[at + 2])) << 8 | uint32_t(uint8_t(bytes[at + 3]));
-  };
-  std::string idat;
-  uint32_t w = 0, h = 0;
-  for (size_t at = 8; at + 12 <= bytes.size();) {
-    const uint32_t length = be32(at);
-    const std::string type = bytes.substr(at + 4, 4);
-    if (at + 12 + length > bytes.size()) return png;
-    if (type == "IHDR") {
-      w = be32(at + 8);
-      h = be32(at + 12);
-      if (bytes[at + 16] != 8 || bytes[at + 17] != 6) return png;
-    }
-    if (type == "IDAT") idat += bytes.substr(at + 8, length);
-    at += 12 + length;
-  }
-  std::vector<uint8_t> raw(size_t(h) * (1 + size_t(w) * 4));
-  uLongf raw_size = uLongf(raw.size());
-  if (w == 0 || uncompress(raw.data(), &raw_size, reinterpret_cast<const Bytef*>(idat.data()), uLong(idat.size())) !=
-                    Z_OK ||
-      raw_size != raw.size())
-    return png;
-  png.rgba.reserve(size_t(w) * h * 4);
-  for (uint32_t y = 0; y < h; ++y) {
-    const uint8_t* row = &raw[size_t(y) * (1 + size_t(w) * 4)];
-    if (row[0] != 0) return Png{};
-    png.rgba.insert(png.rgba.end(), row + 1, row + 1 + size_t(w) * 4);
-  }
-  png.width = w;
-  png.height = h;
-  return png;
-}
+using test::Png;
+using test::readOurPng;
 
 // Pixels in [x0, x1) x [y0, y1) brighter than the black background.
 double coverage(const Png& png, uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1) {
@@ -718,13 +673,30 @@ TEST_F(GpuViewer, scriptOpenOfAMalformedFileShowsTheErrorAndKeepsTheModel) {
   EXPECT_GT(coverage(png, 0, 0, 96, 64), 0.05);  // the phantom is still drawn
 }
 
-TEST_F(GpuViewer, commandLineFileThatCannotBeReadEndsTheRunWithOneLine) {
+TEST_F(GpuViewer, commandLineFileThatCannotBeReadEndsAnOffscreenRunWithOneLine) {
   const std::string bad = dir_.file("bad.tck");
   writeMalformedTck(bad);
   const auto r = runViewer("--offscreen --size 64x64 --frames 2 " + bad);
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_EQ(lineCount(r.output), 1) << r.output;
   EXPECT_NE(r.output.find(bad), std::string::npos) << r.output;
+}
+
+TEST_F(GpuViewer, commandLineFileThatCannotBeReadIsShownInTheWindowAndTheViewerGoesOn) {
+  const std::string bad = dir_.file("bad.tck"), good = dir_.file("good.tck");
+  writeMalformedTck(bad);
+  ASSERT_EQ(test::runFibscope("phantom -n 200 " + good).exit_code, 0);
+  const std::string script = dir_.file("s.txt"), shot = dir_.file("shot.png");
+  test::writeBytes(script, "wait-loaded\nwait 1\nscreenshot " + shot + "\nwait 1\nquit\n");
+  const auto r = runViewer("--size 320x200 --script " + script + " " + bad + " " + good,
+                           "xvfb-run -a -s '-screen 0 640x480x24' env ");
+  ASSERT_EQ(r.output.find("offscreen"), std::string::npos) << "no window was made: " << r.output;
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("fibscope view: " + bad + ": "), std::string::npos) << r.output;
+  // The readable file is drawn beside the panels (the error in the status line).
+  const Png png = readOurPng(shot);
+  ASSERT_EQ(png.width, 320u);
+  EXPECT_GT(coverage(png, 160, 60, 320, 200), 0.01);
 }
 
 TEST_F(GpuViewer, secondOpenOfTheSameFileComesFromTheCache) {

@@ -635,3 +635,32 @@ TEST(VisibilityLayout, FourByTwoBlocksMapEveryPixelToItsOwnKeyInsideThePaddedBuf
 
 }  // namespace
 }  // namespace fibscope
+
+namespace fibscope {
+namespace {
+
+TEST(PointSample, theSameStreamGivesTheSameSampleInAnyChunksAndStaysWithinItsLimit) {
+  const Tractogram all = test::smallTractogram(400, 9);  // ~12 k points
+  ASSERT_GT(all.pointCount(), 10000u);
+  PointSample whole(1000);
+  whole.add(all);
+  // The same points in chunks of a few streamlines, as a streamed read.
+  PointSample chunked(1000);
+  for (size_t first = 0; first < all.streamlineCount(); first += 7) {
+    Tractogram chunk;
+    for (size_t s = first; s < std::min(first + 7, all.streamlineCount()); ++s)
+      chunk.addStreamline(all.point(all.offsets[s]), all.pointsIn(s));
+    chunked.add(chunk);
+  }
+  const std::vector<Vec3d> a = whole.points(), b = chunked.points();
+  EXPECT_EQ(a, b);
+  EXPECT_GE(a.size(), 500u);
+  EXPECT_LE(a.size(), 1000u);
+  // The first point of the stream is always kept.
+  const float* p = all.point(0);
+  EXPECT_EQ(a[0], (Vec3d{p[0], p[1], p[2]}));
+  EXPECT_EQ(samplePoints(all, 500), a);
+}
+
+}  // namespace
+}  // namespace fibscope

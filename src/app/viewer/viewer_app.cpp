@@ -289,9 +289,9 @@ void ViewerApp::createFrameObjects() {
   ModelLoaderOptions loader_options;
   loader_options.phantom_streamlines = options_.phantom_streamlines;
   loader_ = std::make_unique<ModelLoader>(loader_options);
-  // Loaded on the worker while frames are drawn; a file named on the
-  // command line that cannot be read ends the run (as `render` does), from
-  // the UI or a script it only shows the error (pollLoads).
+  // Loaded on the worker while frames are drawn; a file that cannot be
+  // read shows its error (pollLoads; offscreen, one named on the command
+  // line ends the run).
   if (options_.files.empty()) openModel("", true);
   for (const std::string& file : options_.files) openModel(file, true);
 }
@@ -342,8 +342,11 @@ void ViewerApp::pollLoads() {
         event.error = e.what();  // the upload failed (e.g. it does not fit on the device)
       }
     }
-    // A command-line file ends the run with its one-line error (exit 2).
-    if (startup) throw Error(event.error);
+    // A command-line file that cannot be read: in a window it is shown as
+    // one opened from the panel is (status line, the models panel's list of
+    // failures) and the viewer goes on; without a window nobody would see
+    // it, so the run ends with its one-line error (exit 2), as `render`'s.
+    if (startup && !window_) throw Error(event.error);
     state_.status = event.error;
     state_.load_failures.push_back(LoadFailure{event.path, event.error});
     std::fprintf(stderr, "fibscope view: %s\n", event.error.c_str());

@@ -80,13 +80,12 @@ StreamedUpload uploadStreamed(const ContextSource& context,
   using Clock = std::chrono::steady_clock;
   StreamedUpload out;
   auto t0 = Clock::now();
-  // Pass 1: codec parameters, the box, a sample of the points (every
-  // stride-th point, stride doubling when the sample passes 8192).
+  // Pass 1: codec parameters, the box, a sample of the points (PointSample).
   CodecParamEstimator estimator;
   Bounds& box = out.bounds;
   box.min.fill(std::numeric_limits<double>::infinity());
   box.max.fill(-std::numeric_limits<double>::infinity());
-  uint64_t stride = 1, next = 0;
+  PointSample sample;  // as samplePoints would of the whole file
   {
     auto reader = open();
     Tractogram chunk;
@@ -97,21 +96,14 @@ StreamedUpload uploadStreamed(const ContextSource& context,
         box.min[k] = std::min(box.min[k], b.min[k]);
         box.max[k] = std::max(box.max[k], b.max[k]);
       }
-      for (; next < out.points + chunk.pointCount(); next += stride) {
-        const float* p = chunk.point(next - out.points);
-        if (std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2])) out.sample.push_back({p[0], p[1], p[2]});
-        if (out.sample.size() > 8192) {
-          for (size_t i = 0; 2 * i < out.sample.size(); ++i) out.sample[i] = out.sample[2 * i];
-          out.sample.resize((out.sample.size() + 1) / 2);
-          stride *= 2;
-        }
-      }
+      sample.add(chunk);
       out.points += chunk.pointCount();
       out.streamlines += chunk.streamlineCount();
       for (size_t s = 0; s < chunk.streamlineCount(); ++s) out.segments += chunk.pointsIn(s) > 1 ? chunk.pointsIn(s) - 1 : 0;
     }
     out.warnings = reader->warnings();
   }
+  out.sample = sample.points();
   if (out.streamlines == 0) throw Error(name + ": no streamlines to render");
   try {
     out.upload.params = estimator.finish();  // throws for no points or an absurd box
