@@ -11,6 +11,7 @@ namespace fibscope {
 
 void addInfoCommand(CLI::App& app);
 void addConvertCommand(CLI::App& app);
+void addFilterCommand(CLI::App& app);
 void addPhantomCommand(CLI::App& app);
 void addDecompressCommand(CLI::App& app);
 void addCompressCommand(CLI::App& app);

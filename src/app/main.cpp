@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "fibscope 0.1.0");
   fibscope::addInfoCommand(app);
   fibscope::addConvertCommand(app);
+  fibscope::addFilterCommand(app);
   fibscope::addPhantomCommand(app);
   fibscope::addCompressCommand(app);
   fibscope::addDecompressCommand(app);

@@ -211,8 +211,12 @@ TEST_F(GpuFrameStages, spheresAndLinesOccludeEachOtherBothWaysAsTheReferenceInEv
     }
     // Surface pixels carry their source; lines pixels do not.
     for (size_t i = 0; i < texels.size(); ++i) {
-      if (got.spheres[i]) EXPECT_EQ(texels[i].segment, shader::kGBufferSurface | shader::kSurfaceSourceSphere);
-      if (got.lines[i]) EXPECT_EQ(texels[i].segment & shader::kGBufferSurface, 0u);
+      if (got.spheres[i]) {
+        EXPECT_EQ(texels[i].segment, shader::kGBufferSurface | shader::kSurfaceSourceSphere);
+      }
+      if (got.lines[i]) {
+        EXPECT_EQ(texels[i].segment & shader::kGBufferSurface, 0u);
+      }
     }
     const PickResult pick = pickFiber(context(), renderer.targets(), ax, ay);
     EXPECT_TRUE(pick.hit);

@@ -35,11 +35,15 @@ TEST(SettingsTable, namesAreUniqueAndEveryEntryIsComplete) {
   for (const SettingInfo& info : renderSettingsTable()) {
     SCOPED_TRACE(std::string(info.name));
     EXPECT_TRUE(names.insert(std::string(info.name)).second);
-    if (!info.alias.empty()) EXPECT_TRUE(names.insert(std::string(info.alias)).second);
+    if (!info.alias.empty()) {
+      EXPECT_TRUE(names.insert(std::string(info.alias)).second);
+    }
     EXPECT_FALSE(info.label.empty());
     EXPECT_FALSE(info.help.empty());
     EXPECT_EQ(findSetting(info.name), &info);
-    if (info.kind == SettingKind::Number || info.kind == SettingKind::Integer) EXPECT_LT(info.min, info.max);
+    if (info.kind == SettingKind::Number || info.kind == SettingKind::Integer) {
+      EXPECT_LT(info.min, info.max);
+    }
   }
   EXPECT_EQ(findSetting("width"), findSetting("line-width"));
   EXPECT_EQ(findSetting("no-such-setting"), nullptr);

@@ -1,0 +1,68 @@
+// Which streamlines a set of criteria keeps: the semantics of MRtrix3's
+// tckedit (3.0), so that `fibscope filter` and `tckedit` keep the same
+// streamlines, and the GPU kept-bit pass (later) the same as both.
+//
+// For each streamline, in this order:
+//   1. length: the sum of its segments' lengths in float (0 for one point,
+//      NaN, so dropped, for none) within [min_length - m, max_length + m],
+//      m = 0.1 x the file's step size where the header states one
+//      ("output_step_size", else "step_size"), else 0 (tckedit's margin for
+//      lengths computed in float);
+//   2. the vertices (only the first and the last with ends_only), in order:
+//      one inside any exclude region drops the streamline; every include
+//      region must contain at least one vertex; the ordered includes must
+//      be entered in their order: a vertex in ordered region k (the first
+//      that contains it) is fine when k is the next one to enter or the one
+//      entered last, anything else breaks the order;
+// and it is kept when it passes all of them.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/tractogram.h"
+#include "select/region.h"
+
+namespace fibscope {
+
+struct FilterCriteria {
+  std::vector<Region> include;          // each must contain a vertex (tckedit -include)
+  std::vector<Region> include_ordered;  // entered in this order (tckedit -include_ordered)
+  std::vector<Region> exclude;          // none may contain a vertex (tckedit -exclude)
+  bool ends_only = false;               // test only the two end vertices (tckedit -ends_only)
+  double min_length_mm = NAN;           // NaN: no limit
+  double max_length_mm = NAN;
+  bool empty() const;
+};
+
+// Why a streamline was dropped (Kept: it was not).
+enum class FilterReason : uint8_t { Kept, Length, Exclude, Include, IncludeOrdered };
+
+struct FilterVerdict {
+  FilterReason reason = FilterReason::Kept;
+  uint32_t region = 0;  // Exclude / Include / IncludeOrdered: the region's index in its list
+  bool kept() const { return reason == FilterReason::Kept; }
+};
+
+// The step size the file's header states (tck: "output_step_size", else
+// "step_size"; a number > 0), or NaN.
+float headerStepSize(const TractogramHeader& header);
+
+class FiberFilter {
+ public:
+  // Throws Error for a min length above the max length or a negative one.
+  FiberFilter(FilterCriteria criteria, float step_size_mm = NAN);
+  const FilterCriteria& criteria() const { return criteria_; }
+
+  // The verdict for the streamline of n points (x, y, z interleaved).
+  FilterVerdict evaluate(const float* xyz, size_t n) const;
+
+ private:
+  FilterCriteria criteria_;
+  float min_length_ = -INFINITY, max_length_ = INFINITY;  // with the margin
+};
+
+}  // namespace fibscope

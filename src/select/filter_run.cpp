@@ -1,0 +1,94 @@
+#include "select/filter_run.h"
+
+#include <algorithm>
+#include <future>
+#include <thread>
+
+#include "core/thread_pool.h"
+
+namespace fibscope {
+namespace {
+
+// Points a chunk holds: large enough that a chunk's work dwarfs the
+// threads' start, small enough that two stay in cache-friendly memory.
+constexpr size_t kChunkPoints = size_t(1) << 20;
+
+}  // namespace
+
+void appendKeptStreamlines(const Tractogram& in, const std::vector<uint8_t>& keep, Tractogram& out) {
+  for (size_t s = 0; s < in.streamlineCount(); ++s) {
+    if (!keep[s]) continue;
+    const uint64_t first = in.offsets[s], n = in.pointsIn(s);
+    out.addStreamline(in.point(first), n);
+    for (size_t a = 0; a < in.per_streamline.size(); ++a) {
+      const DataArray& from = in.per_streamline[a];
+      const auto begin = from.values.begin() + ptrdiff_t(s * from.components);
+      out.per_streamline[a].values.insert(out.per_streamline[a].values.end(), begin, begin + from.components);
+    }
+    for (size_t a = 0; a < in.per_point.size(); ++a) {
+      const DataArray& from = in.per_point[a];
+      const auto begin = from.values.begin() + ptrdiff_t(first * from.components);
+      out.per_point[a].values.insert(out.per_point[a].values.end(), begin, begin + ptrdiff_t(n * from.components));
+    }
+  }
+}
+
+FilterReport runFilter(TractogramReader& reader, TractogramWriter& writer, const FiberFilter& filter,
+                       unsigned threads, const std::function<void(uint64_t)>& progress) {
+  const FilterCriteria& c = filter.criteria();
+  FilterReport report;
+  report.by_exclude.assign(c.exclude.size(), 0);
+  report.by_include.assign(c.include.size(), 0);
+  if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
+
+  Tractogram chunks[2], kept;
+  std::vector<FilterVerdict> verdicts;
+  std::vector<uint8_t> keep;
+  bool more = reader.read(chunks[0], kChunkPoints);
+  for (int current = 0; more; current ^= 1) {
+    const Tractogram& chunk = chunks[current];
+    // The next chunk is read on another thread while this one is tested
+    // and written (the reader is used by one thread at a time).
+    std::future<bool> next = std::async(std::launch::async, [&reader, &chunks, current] {
+      return reader.read(chunks[current ^ 1], kChunkPoints);
+    });
+    const size_t n = chunk.streamlineCount();
+    verdicts.assign(n, FilterVerdict{});
+    const unsigned pieces = unsigned(std::min<size_t>(threads, std::max<size_t>(1, chunk.pointCount() / 65536)));
+    runPieces(pieces, [&](unsigned piece) {
+      for (size_t s = n * piece / pieces; s < n * (piece + 1) / pieces; ++s)
+        verdicts[s] = filter.evaluate(chunk.point(chunk.offsets[s]), chunk.pointsIn(s));
+    });
+    keep.assign(n, 0);
+    for (size_t s = 0; s < n; ++s) {
+      const FilterVerdict& v = verdicts[s];
+      switch (v.reason) {
+        case FilterReason::Kept:
+          keep[s] = 1;
+          ++report.kept;
+          report.kept_points += chunk.pointsIn(s);
+          break;
+        case FilterReason::Length: ++report.by_length; break;
+        case FilterReason::Exclude: ++report.by_exclude[v.region]; break;
+        case FilterReason::Include: ++report.by_include[v.region]; break;
+        case FilterReason::IncludeOrdered: ++report.by_order; break;
+      }
+    }
+    report.streamlines += n;
+    report.points += chunk.pointCount();
+    kept.clear();
+    if (kept.per_streamline.size() != chunk.per_streamline.size() || kept.per_point.size() != chunk.per_point.size()) {
+      kept.per_streamline.clear();
+      kept.per_point.clear();
+      for (const DataArray& a : chunk.per_streamline) kept.per_streamline.push_back({a.name, a.components, a.dtype, {}});
+      for (const DataArray& a : chunk.per_point) kept.per_point.push_back({a.name, a.components, a.dtype, {}});
+    }
+    appendKeptStreamlines(chunk, keep, kept);
+    writer.write(kept);
+    more = next.get();
+    if (progress) progress(reader.bytesRead());
+  }
+  return report;
+}
+
+}  // namespace fibscope

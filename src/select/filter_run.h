@@ -1,0 +1,39 @@
+// `fibscope filter`'s work: the streamlines of a reader that a FiberFilter
+// keeps, with their per-streamline and per-point data, to a writer, in
+// their order. Streams in chunks (memory bounded by two chunks whatever
+// the input's size); the next chunk is read while the current one is
+// tested (on every core) and written.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "io/reader.h"
+#include "io/writer.h"
+#include "select/fiber_filter.h"
+
+namespace fibscope {
+
+struct FilterReport {
+  uint64_t streamlines = 0, points = 0;  // read
+  uint64_t kept = 0, kept_points = 0;
+  uint64_t by_length = 0;                // dropped by the length limits
+  std::vector<uint64_t> by_exclude;      // per exclude region: dropped by entering it
+  std::vector<uint64_t> by_include;      // per include region: dropped for missing it (the first missed)
+  uint64_t by_order = 0;                 // dropped for the ordered includes (missed or out of order)
+};
+
+// Filters everything `reader` gives into `writer` (which the caller
+// finishes). `progress` is called after each chunk with the reader's
+// bytes so far. `threads`: 0 = every core. Throws what the reader and the
+// writer throw.
+FilterReport runFilter(TractogramReader& reader, TractogramWriter& writer, const FiberFilter& filter,
+                       unsigned threads = 0, const std::function<void(uint64_t bytes)>& progress = {});
+
+// The streamlines of `in` whose `keep` entry is non-zero, with their data,
+// appended to `out` (whose arrays must be named as `in`'s).
+void appendKeptStreamlines(const Tractogram& in, const std::vector<uint8_t>& keep, Tractogram& out);
+
+}  // namespace fibscope

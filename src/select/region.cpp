@@ -1,0 +1,117 @@
+#include "select/region.h"
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <glm/glm.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+#include <vector>
+
+#include "core/error.h"
+
+namespace fibscope {
+namespace {
+
+// Comma-separated finite numbers.
+bool parseNumbers(std::string_view text, std::vector<double>& out) {
+  out.clear();
+  while (true) {
+    const size_t comma = text.find(',');
+    const std::string_view item = text.substr(0, comma);
+    double v = 0;
+    const auto [end, ec] = std::from_chars(item.data(), item.data() + item.size(), v);
+    if (ec != std::errc() || end != item.data() + item.size() || !std::isfinite(v)) return false;
+    out.push_back(v);
+    if (comma == std::string_view::npos) return true;
+    text.remove_prefix(comma + 1);
+  }
+}
+
+std::string number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.9g", v);
+  return buf;
+}
+
+}  // namespace
+
+bool regionContains(const Region& region, const float* p) {
+  if (const auto* s = std::get_if<SphereRegion>(&region)) {
+    // As MRtrix3's ROI::contains: (pos - p).squaredNorm() <= radius^2, in float.
+    const float dx = s->center[0] - p[0], dy = s->center[1] - p[1], dz = s->center[2] - p[2];
+    return (dx * dx + dy * dy) + dz * dz <= s->radius * s->radius;
+  }
+  if (const auto* b = std::get_if<BoxRegion>(&region)) {
+    for (int k = 0; k < 3; ++k)
+      if (!(p[k] >= b->min[k] && p[k] <= b->max[k])) return false;
+    return true;
+  }
+  const auto& o = std::get<OrientedBoxRegion>(region);
+  const glm::dvec3 d = glm::dvec3(p[0], p[1], p[2]) - glm::dvec3(o.center[0], o.center[1], o.center[2]);
+  for (int k = 0; k < 3; ++k) {
+    const glm::dvec3 axis(o.axes[k][0], o.axes[k][1], o.axes[k][2]);
+    if (!(std::fabs(glm::dot(d, axis)) <= o.half[k])) return false;
+  }
+  return true;
+}
+
+Region parseRegion(std::string_view spec) {
+  const std::string text(spec);
+  const size_t colon = spec.find(':');
+  const std::string_view kind = colon == std::string_view::npos ? std::string_view("sphere") : spec.substr(0, colon);
+  const std::string_view values = colon == std::string_view::npos ? spec : spec.substr(colon + 1);
+  std::vector<double> v;
+  const bool numbers = parseNumbers(values, v);
+  if (kind == "sphere") {
+    if (!numbers || v.size() != 4)
+      fail(text, "expected a sphere as sphere:X,Y,Z,R (mm; or X,Y,Z,R)");
+    if (!(v[3] > 0)) fail(text, "a sphere's radius must be > 0 mm");
+    return SphereRegion{{float(v[0]), float(v[1]), float(v[2])}, float(v[3])};
+  }
+  if (kind == "box") {
+    if (!numbers || v.size() != 6) fail(text, "expected a box as box:X0,Y0,Z0,X1,Y1,Z1 (two opposite corners, mm)");
+    BoxRegion b;
+    for (int k = 0; k < 3; ++k) {
+      b.min[k] = std::min(v[k], v[k + 3]);
+      b.max[k] = std::max(v[k], v[k + 3]);
+    }
+    return b;
+  }
+  if (kind == "obox") {
+    if (!numbers || v.size() != 9)
+      fail(text, "expected an oriented box as obox:CX,CY,CZ,SX,SY,SZ,AX,AY,AZ (centre and sizes in mm, rotation "
+                 "about x, y, z in degrees)");
+    if (!(v[3] > 0 && v[4] > 0 && v[5] > 0)) fail(text, "an oriented box's sizes must be > 0 mm");
+    // R = Rz Ry Rx: the box's axes are R's columns.
+    glm::dmat4 r(1.0);
+    r = glm::rotate(r, glm::radians(v[8]), glm::dvec3(0, 0, 1));
+    r = glm::rotate(r, glm::radians(v[7]), glm::dvec3(0, 1, 0));
+    r = glm::rotate(r, glm::radians(v[6]), glm::dvec3(1, 0, 0));
+    OrientedBoxRegion o;
+    o.center = {v[0], v[1], v[2]};
+    o.angles_deg = {v[6], v[7], v[8]};
+    for (int k = 0; k < 3; ++k) {
+      o.axes[k] = {r[k][0], r[k][1], r[k][2]};
+      o.half[k] = v[3 + k] / 2;
+    }
+    return o;
+  }
+  fail(text, "unknown region kind '" + std::string(kind) + "' (expected sphere:, box: or obox:)");
+}
+
+std::string regionSpec(const Region& region) {
+  if (const auto* s = std::get_if<SphereRegion>(&region))
+    return "sphere:" + number(s->center[0]) + "," + number(s->center[1]) + "," + number(s->center[2]) + "," +
+           number(s->radius);
+  if (const auto* b = std::get_if<BoxRegion>(&region))
+    return "box:" + number(b->min[0]) + "," + number(b->min[1]) + "," + number(b->min[2]) + "," + number(b->max[0]) +
+           "," + number(b->max[1]) + "," + number(b->max[2]);
+  const auto& o = std::get<OrientedBoxRegion>(region);
+  std::string out = "obox:";
+  for (const double x : {o.center[0], o.center[1], o.center[2], 2 * o.half[0], 2 * o.half[1], 2 * o.half[2],
+                         o.angles_deg[0], o.angles_deg[1], o.angles_deg[2]})
+    out += (out.size() > 5 ? "," : "") + number(x);
+  return out;
+}
+
+}  // namespace fibscope
