@@ -5,6 +5,7 @@
 #include <emmintrin.h>
 #endif
 #include <cmath>
+#include <glm/glm.hpp>
 #include <limits>
 #include <numbers>
 #include <string>
@@ -138,21 +139,21 @@ void CodecParamEstimator::add(const Tractogram& chunk) {
       const size_t i = size_t(next_sample_ - segments_) + 1;  // the segment from point i - 1 to i
       const float* b = chunk.point(first + i);
       const float* a = b - 3;
-      const double d[3] = {double(b[0]) - a[0], double(b[1]) - a[1], double(b[2]) - a[2]};
-      const double len2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+      const glm::dvec3 d = glm::dvec3(b[0], b[1], b[2]) - glm::dvec3(a[0], a[1], a[2]);
+      const double len2 = glm::dot(d, d);
       SegmentSample sample{std::isfinite(len2) ? float(std::sqrt(len2)) : nan, nan};
       if (i >= 2 && std::isfinite(len2) && len2 > 0) {
         const float* z = a - 3;
-        const double e[3] = {double(a[0]) - z[0], double(a[1]) - z[1], double(a[2]) - z[2]};
-        const double prev2 = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
+        const glm::dvec3 e = glm::dvec3(a[0], a[1], a[2]) - glm::dvec3(z[0], z[1], z[2]);
+        const double prev2 = glm::dot(e, e);
         if (prev2 > 0 && std::isfinite(prev2)) {
           // tan^2 of the turn, |e x d|^2 / (e . d)^2: monotonic in the angle
           // below 90 degrees (turns beyond count as infinite), exact for
           // small turns where 1 - cos would cancel, and no acos per sample.
           // summary() converts the percentile.
-          const double dot = d[0] * e[0] + d[1] * e[1] + d[2] * e[2];
-          const double cx = e[1] * d[2] - e[2] * d[1], cy = e[2] * d[0] - e[0] * d[2], cz = e[0] * d[1] - e[1] * d[0];
-          const double tan2 = dot > 0 ? (cx * cx + cy * cy + cz * cz) / (dot * dot) : kInfiniteTurn;
+          const double dot = glm::dot(d, e);
+          const glm::dvec3 c = glm::cross(e, d);
+          const double tan2 = dot > 0 ? glm::dot(c, c) / (dot * dot) : kInfiniteTurn;
           sample.turn = float(std::min(tan2, kInfiniteTurn));
         }
       }

@@ -32,9 +32,8 @@ uint32_t blockOrigin(DirectionGrid g, int size) {
   return clampedFloor(g.u - shift, last) << 4 | clampedFloor(g.v - shift, last);
 }
 
-DirectionGrid encodeDirectionGrid(const double direction[3], double alpha) {
-  const double norm =
-      std::sqrt(direction[0] * direction[0] + direction[1] * direction[1] + direction[2] * direction[2]);
+DirectionGrid encodeDirectionGrid(const glm::dvec3& direction, double alpha) {
+  const double norm = glm::length(direction);
   double x = 0, y = 0, z = 1;
   // Non-finite input (NaN points) encodes as straight ahead rather than
   // reaching an out-of-range float -> int conversion.
@@ -52,7 +51,7 @@ DirectionGrid encodeDirectionGrid(const double direction[3], double alpha) {
   return gridOf(hx / s, hy / s);
 }
 
-uint32_t encodeDirection(const double direction[3], double alpha) {
+uint32_t encodeDirection(const glm::dvec3& direction, double alpha) {
   return cellOf(encodeDirectionGrid(direction, alpha));
 }
 
@@ -74,10 +73,10 @@ FastDirectionQuantizer::FastDirectionQuantizer(double alpha, double step)
   plane_scale_ = kPlaneBins / (2 * half_width);
   for (int i = 0; i < kPlaneBins; ++i) {
     for (int j = 0; j < kPlaneBins; ++j) {
-      const double d[3] = {((i + 0.5) / plane_scale_) - half_width, ((j + 0.5) / plane_scale_) - half_width, 0};
-      const double r2 = d[0] * d[0] + d[1] * d[1];
+      const double dx = ((i + 0.5) / plane_scale_) - half_width, dy = ((j + 0.5) / plane_scale_) - half_width;
+      const double r2 = dx * dx + dy * dy;
       // Outside the unit disc: on the equator, i.e. beyond the cap (clamped to the rim).
-      const double dir[3] = {d[0], d[1], r2 < 1 ? std::sqrt(1 - r2) : 0.0};
+      const glm::dvec3 dir(dx, dy, r2 < 1 ? std::sqrt(1 - r2) : 0.0);
       plane_[size_t(i * kPlaneBins + j)] = uint8_t(blockOrigin(encodeDirectionGrid(dir, alpha), 2));
     }
   }

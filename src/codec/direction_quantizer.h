@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstdint>
+#include <glm/glm.hpp>
 
 namespace fibscope {
 
@@ -20,14 +21,14 @@ struct DirectionGrid {
 // The exact position, in double with trigonometry: the reference, and the
 // open-loop encoder's quantiser (the paper's). `direction` need not be
 // unit; a zero or non-finite one encodes as straight ahead.
-DirectionGrid encodeDirectionGrid(const double direction[3], double alpha);
+DirectionGrid encodeDirectionGrid(const glm::dvec3& direction, double alpha);
 // The code of the cell holding g.
 uint32_t cellOf(DirectionGrid g);
 // The code of the first cell (lowest u and v) of the size x size block of
 // cells nearest g, kept inside the grid; the block always holds cellOf(g).
 uint32_t blockOrigin(DirectionGrid g, int size);
 // cellOf(encodeDirectionGrid(direction, alpha)).
-uint32_t encodeDirection(const double direction[3], double alpha);
+uint32_t encodeDirection(const glm::dvec3& direction, double alpha);
 
 // A fast blockOrigin(encodeDirectionGrid(d), 2) for the closed-loop
 // encoder's inner loop, where d is the vector from the decoded point to

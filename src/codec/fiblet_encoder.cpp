@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <glm/glm.hpp>
 #include <limits>
 #include <numbers>
 #include <string>
@@ -32,7 +33,7 @@ double EncodeReport::maxTurnDegrees() const {
   return std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / std::numbers::pi;
 }
 
-float FibletEncoder::search(const double local[3], uint32_t& code) const {
+float FibletEncoder::search(const glm::dvec3& local, uint32_t& code) const {
   const auto lx = float(local[0]), ly = float(local[1]), lz = float(local[2]);
   if (options_.search_size == 2) {
     // The default: the 2 x 2 cells nearest the goal's direction, one
@@ -71,12 +72,18 @@ float FibletEncoder::search(const double local[3], uint32_t& code) const {
   return best;
 }
 
+namespace {
+
+// The point at p (x, y, z) of a lane's targets.
+glm::dvec3 point(const double* p) { return {p[0], p[1], p[2]}; }
+
+}  // namespace
+
 void FibletEncoder::noteTurn(const Lane& lane, size_t j) {
   const double* p = lane.target.data() + 3 * j;
-  const double a[3] = {p[0] - p[-3], p[1] - p[-2], p[2] - p[-1]};
-  const double b[3] = {p[3] - p[0], p[4] - p[1], p[5] - p[2]};
-  const double dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-  const double a2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2], b2 = b[0] * b[0] + b[1] * b[1] + b[2] * b[2];
+  const glm::dvec3 a = point(p) - point(p - 3), b = point(p + 3) - point(p);
+  const double dot = glm::dot(a, b);
+  const double a2 = glm::dot(a, a), b2 = glm::dot(b, b);
   if (std::isfinite(dot) && std::isfinite(a2) && std::isfinite(b2)) noteTurn(dot, b2, a2);
 }
 
@@ -118,10 +125,13 @@ FibletEncoder::FibletEncoder(const CodecParams& params, const EncodeOptions& opt
 
 namespace {
 
-double dot3(const vec3& a, const double b[3]) { return double(a.x) * b[0] + double(a.y) * b[1] + double(a.z) * b[2]; }
-double dot3(V4f a, const double b[3]) { return double(a[0]) * b[0] + double(a[1]) * b[1] + double(a[2]) * b[2]; }
+// The frame's axes in double (the products and sums in glm::dot's order,
+// x + y then + z, as the encoder always did: the encoding stays bit for bit).
+glm::dvec3 axis(const vec3& a) { return {a.x, a.y, a.z}; }
+glm::dvec3 axis(V4f a) { return {a[0], a[1], a[2]}; }
 
 vec3 toVec3(const double* p) { return vec3(float(p[0]), float(p[1]), float(p[2])); }
+vec3 toVec3(const glm::dvec3& p) { return vec3(float(p.x), float(p.y), float(p.z)); }
 
 }  // namespace
 
@@ -210,11 +220,10 @@ bool FibletEncoder::stepFiblet(Lane& lane) {
   const size_t k = lane.k;
   if (k >= lane.count_max) return false;
   const double* here = lane.target.data() + 3 * (lane.first + k);
-  const double seg[3] = {here[0] - here[-3], here[1] - here[-2], here[2] - here[-1]};
-  const double prev[3] = {here[-3] - here[-6], here[-2] - here[-5], here[-1] - here[-4]};
-  const double len2 = seg[0] * seg[0] + seg[1] * seg[1] + seg[2] * seg[2];
-  const double plen2 = prev[0] * prev[0] + prev[1] * prev[1] + prev[2] * prev[2];
-  const double turn_dot = seg[0] * prev[0] + seg[1] * prev[1] + seg[2] * prev[2];
+  const glm::dvec3 seg = point(here) - point(here - 3), prev = point(here - 3) - point(here - 6);
+  const double len2 = glm::dot(seg, seg);
+  const double plen2 = glm::dot(prev, prev);
+  const double turn_dot = glm::dot(seg, prev);
   noteTurn(turn_dot, len2, plen2);
   // Step and turn checks on squared quantities (no sqrt or division per
   // point): |len - delta| <= tol * delta and cos(turn) >= cos(alpha).
@@ -235,18 +244,19 @@ bool FibletEncoder::stepFiblet(Lane& lane) {
     // rotation (orthonormal to float precision), so the distance of a
     // candidate's decoded point W * L_c.t to the original point equals
     // |L_c.t - local|: the search runs in local coordinates.
-    const double diff[3] = {here[0] - w.t[0], here[1] - w.t[1], here[2] - w.t[2]};
-    const double local[3] = {dot3(w.c0, diff), dot3(w.c1, diff), dot3(w.c2, diff)};
+    const glm::dvec3 diff = point(here) - glm::dvec3(w.t[0], w.t[1], w.t[2]);
+    const glm::dvec3 local(glm::dot(axis(w.c0), diff), glm::dot(axis(w.c1), diff), glm::dot(axis(w.c2), diff));
     const float best = search(local, code);
     if (double(best) > max_error2_) {
       ++report_.error_splits;
       return false;
     }
   } else if (options_.mode == EncodeMode::OpenLoop) {
-    const double local[3] = {dot3(w.c0, seg), dot3(w.c1, seg), dot3(w.c2, seg)};
+    const glm::dvec3 local(glm::dot(axis(w.c0), seg), glm::dot(axis(w.c1), seg), glm::dot(axis(w.c2), seg));
     code = encodeDirection(local, params_.alpha);
   } else {
-    const double local[3] = {dot3(lane.truth.c0, seg), dot3(lane.truth.c1, seg), dot3(lane.truth.c2, seg)};
+    const glm::dvec3 local(glm::dot(axis(lane.truth.c0), seg), glm::dot(axis(lane.truth.c1), seg),
+                           glm::dot(axis(lane.truth.c2), seg));
     code = encodeDirection(local, params_.alpha);
     const vec3 exact = toVec3(local) * float(1.0 / std::sqrt(len2));
     lane.truth = shader::fibletCompose(lane.truth, shader::fibletLocalTransform(exact, v_, params_.delta));
@@ -374,13 +384,11 @@ EncodedFiblets encodeTractogram(const Tractogram& tractogram, const CodecParams&
 namespace {
 
 // Distance from p to the segment [a, b].
-double pointSegmentDistance(const float* p, const double a[3], const double b[3]) {
-  const double ab[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-  const double ap[3] = {p[0] - a[0], p[1] - a[1], p[2] - a[2]};
-  const double len2 = ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2];
-  const double u = len2 > 0 ? std::clamp((ab[0] * ap[0] + ab[1] * ap[1] + ab[2] * ap[2]) / len2, 0.0, 1.0) : 0.0;
-  const double d[3] = {ap[0] - u * ab[0], ap[1] - u * ab[1], ap[2] - u * ab[2]};
-  return std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+double pointSegmentDistance(const float* p, const glm::dvec3& a, const glm::dvec3& b) {
+  const glm::dvec3 ab = b - a, ap = glm::dvec3(p[0], p[1], p[2]) - a;
+  const double len2 = glm::dot(ab, ab);
+  const double u = len2 > 0 ? std::clamp(glm::dot(ab, ap) / len2, 0.0, 1.0) : 0.0;
+  return glm::length(ap - u * ab);
 }
 
 }  // namespace
@@ -428,11 +436,11 @@ Tractogram resampleToStep(const Tractogram& in, double step_mm, ResampleReport* 
                            std::to_string(kMaxResampledPoints) + " steps of " + std::to_string(step_mm) + " mm");
     if (n > 0) out.positions.insert(out.positions.end(), p, p + 3);
     if (n >= 2) {
-      double cur[3] = {p[0], p[1], p[2]};
+      glm::dvec3 cur(p[0], p[1], p[2]);
       // Input vertices passed since the last output point: they lie between
       // it and the next one, and are measured against that chord.
       size_t pending_from = 1, pending_to = 1;
-      auto measure = [&](const double from[3], const double to[3]) {
+      auto measure = [&](const glm::dvec3& from, const glm::dvec3& to) {
         for (size_t i = pending_from; i < pending_to; ++i) {
           const double dev = pointSegmentDistance(p + 3 * i, from, to);
           deviation_sum += dev;
@@ -446,8 +454,8 @@ Tractogram resampleToStep(const Tractogram& in, double step_mm, ResampleReport* 
       while (seg + 1 < n) {
         const float* a = p + 3 * seg;
         const float* b = a + 3;
-        const double bc[3] = {b[0] - cur[0], b[1] - cur[1], b[2] - cur[2]};
-        if (bc[0] * bc[0] + bc[1] * bc[1] + bc[2] * bc[2] < step2) {
+        const glm::dvec3 bc = glm::dvec3(b[0], b[1], b[2]) - cur;
+        if (glm::dot(bc, bc) < step2) {
           ++seg;
           u = 0;
           pending_to = seg + 1 < n ? seg + 1 : seg;  // vertex seg passed (the last one is kept)
@@ -456,26 +464,24 @@ Tractogram resampleToStep(const Tractogram& in, double step_mm, ResampleReport* 
         // |a + x d - cur| = step has its larger root in [u, 1]: |a + u d -
         // cur| <= step (cur itself or a vertex inside the sphere) and
         // |b - cur| >= step.
-        const double d[3] = {double(b[0]) - a[0], double(b[1]) - a[1], double(b[2]) - a[2]};
-        const double e[3] = {a[0] - cur[0], a[1] - cur[1], a[2] - cur[2]};
-        const double qa = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-        const double qb = 2 * (d[0] * e[0] + d[1] * e[1] + d[2] * e[2]);
-        const double qc = e[0] * e[0] + e[1] * e[1] + e[2] * e[2] - step2;
+        const glm::dvec3 pa(a[0], a[1], a[2]);
+        const glm::dvec3 d = glm::dvec3(b[0], b[1], b[2]) - pa;
+        const glm::dvec3 e = pa - cur;
+        const double qa = glm::dot(d, d);
+        const double qb = 2 * glm::dot(d, e);
+        const double qc = glm::dot(e, e) - step2;
         const double root = (-qb + std::sqrt(std::max(qb * qb - 4 * qa * qc, 0.0))) / (2 * qa);
         u = std::clamp(root, u, 1.0);
-        const double previous[3] = {cur[0], cur[1], cur[2]};
-        for (int c = 0; c < 3; ++c) {
-          cur[c] = a[c] + u * d[c];
-          out.positions.push_back(float(cur[c]));
-        }
+        const glm::dvec3 previous = cur;
+        cur = pa + u * d;
+        for (int c = 0; c < 3; ++c) out.positions.push_back(float(cur[c]));
         measure(previous, cur);
         ++counts.moved_points;
       }
       const float* last = p + 3 * (n - 1);
-      const double gap2 = (last[0] - cur[0]) * (last[0] - cur[0]) + (last[1] - cur[1]) * (last[1] - cur[1]) +
-                          (last[2] - cur[2]) * (last[2] - cur[2]);
+      const glm::dvec3 end(last[0], last[1], last[2]);
+      const double gap2 = glm::dot(end - cur, end - cur);
       if (gap2 > 0) out.positions.insert(out.positions.end(), last, last + 3);
-      const double end[3] = {last[0], last[1], last[2]};
       measure(cur, end);
     }
     out.offsets.push_back(out.positions.size() / 3);

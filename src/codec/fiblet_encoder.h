@@ -6,6 +6,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <glm/glm.hpp>
 
 #include "codec/codec_error.h"
 #include "codec/codec_params.h"
@@ -150,7 +151,7 @@ class FibletEncoder {
   // Closed loop: the code among options_.search_size^2 cells around the
   // direction of `local` whose step lands nearest `local` (the original
   // point in the decoded frame); returns the squared distance.
-  float search(const double local[3], uint32_t& code) const;
+  float search(const glm::dvec3& local, uint32_t& code) const;
   struct Block {
     V4f x, y, z;  // steps of the 2 x 2 cells at an origin, row-major
   };

@@ -344,7 +344,7 @@ TEST(FastDirectionQuantizer, blockHoldsTheExactCellAndMatchesTheExactBlockAwayFr
       d[2] = std::sqrt(std::max(1 - d[0] * d[0] - d[1] * d[1], 0.0));
       const double length = step * (1 + 0.1 * unit(rng));
       for (double& c : d) c *= length;
-      const DirectionGrid exact = encodeDirectionGrid(d, alpha);
+      const DirectionGrid exact = encodeDirectionGrid(glm::dvec3(d[0], d[1], d[2]), alpha);
       const uint32_t got = fast.block2(d[0], d[1], d[2]);
       ++total;
       same += got == blockOrigin(exact, 2);
@@ -360,7 +360,7 @@ TEST(FastDirectionQuantizer, blockHoldsTheExactCellAndMatchesTheExactBlockAwayFr
   // Far from the step, backwards and degenerate vectors take the formula.
   const FastDirectionQuantizer fast(10 * kDeg, 1.0);
   for (const auto& d : std::vector<std::array<double, 3>>{{0.1, 0.2, 5}, {0.3, -0.1, -1}, {0, 0, -1}, {0, 0, 0}}) {
-    EXPECT_EQ(fast.block2(d[0], d[1], d[2]), blockOrigin(encodeDirectionGrid(d.data(), 10 * kDeg), 2));
+    EXPECT_EQ(fast.block2(d[0], d[1], d[2]), blockOrigin(encodeDirectionGrid(glm::dvec3(d[0], d[1], d[2]), 10 * kDeg), 2));
   }
   // Blocks stay inside the grid and hold the cell at every corner.
   for (const DirectionGrid g :

@@ -99,8 +99,7 @@ TEST(FibletDirections, everyCodeDecodesAndReencodesToItself) {
   for (double alpha_deg : {1.0, 5.0, 15.0, 22.5, 45.0, 60.0, 89.0, 90.0}) {
     for (uint32_t code = 0; code < 256; ++code) {
       const vec3 d = decodeDirection(code, alpha_deg * kDeg);
-      const double dir[3] = {d.x, d.y, d.z};
-      EXPECT_EQ(encodeDirection(dir, alpha_deg * kDeg), code) << "alpha " << alpha_deg << " code " << code;
+      EXPECT_EQ(encodeDirection(glm::dvec3(d.x, d.y, d.z), alpha_deg * kDeg), code) << "alpha " << alpha_deg << " code " << code;
     }
   }
 }
@@ -130,7 +129,7 @@ TEST(FibletDirections, capMappingScalesThePolarAngleAndKeepsTheAzimuth) {
     EXPECT_GT(widest, 0.95 * alpha);
   }
   // A direction outside the cap is clamped to its rim, not wrapped.
-  const double sideways[3] = {1, 0, 0.2};
+  const glm::dvec3 sideways(1, 0, 0.2);
   const vec3 rim = decodeDirection(encodeDirection(sideways, 10 * kDeg), 10 * kDeg);
   EXPECT_GT(std::acos(double(rim.z)), 9 * kDeg);
 }
