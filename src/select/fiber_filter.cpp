@@ -42,6 +42,9 @@ FiberFilter::FiberFilter(FilterCriteria criteria, float step_size_mm) : criteria
   const double lo = criteria_.min_length_mm, hi = criteria_.max_length_mm;
   if (lo < 0 || hi < 0) throw Error("filter: lengths must be >= 0 mm");
   if (lo > hi) throw Error("filter: the minimum length is above the maximum length");
+  for (const auto* list : {&criteria_.include, &criteria_.include_ordered, &criteria_.exclude})
+    if (list->size() > kMaxRegions)
+      throw Error("filter: at most " + std::to_string(kMaxRegions) + " regions of each kind");
   const float margin = std::isfinite(step_size_mm) ? 0.1f * step_size_mm : 0.0f;
   if (!std::isnan(lo)) min_length_ = float(lo) - margin;
   if (!std::isnan(hi)) max_length_ = float(hi) + margin;
@@ -52,14 +55,16 @@ FilterVerdict FiberFilter::evaluate(const float* xyz, size_t n) const {
   if (!(length >= min_length_ && length <= max_length_)) return {FilterReason::Length, 0};
   const FilterCriteria& c = criteria_;
   if (c.include.empty() && c.include_ordered.empty() && c.exclude.empty()) return {};
-  // Which include regions a vertex has reached, and the ordered ones'
-  // progress: `next` to enter, the order broken or not.
-  std::vector<char> reached(c.include.size(), 0);
+  // Which include regions a vertex has reached (a bit each: no allocation
+  // per streamline, at most kMaxRegions), and the ordered ones' progress:
+  // `next` to enter, the order broken or not.
+  uint64_t reached = 0;
   size_t next = 0;
   bool in_order = true;
-  auto visit = [&](const float* p) -> bool {  // false: excluded
+  // The exclude region p lies in, or -1 after noting p's includes.
+  auto visit = [&](const float* p) -> int {
     for (size_t r = 0; r < c.include.size(); ++r)
-      if (!reached[r] && regionContains(c.include[r], p)) reached[r] = 1;
+      if (!(reached >> r & 1u) && regionContains(c.include[r], p)) reached |= uint64_t(1) << r;
     if (in_order)
       for (size_t r = 0; r < c.include_ordered.size(); ++r)
         if (regionContains(c.include_ordered[r], p)) {
@@ -68,23 +73,18 @@ FilterVerdict FiberFilter::evaluate(const float* xyz, size_t n) const {
           break;
         }
     for (size_t r = 0; r < c.exclude.size(); ++r)
-      if (regionContains(c.exclude[r], p)) return false;
-    return true;
-  };
-  auto excludedBy = [&](const float* p) -> FilterVerdict {
-    for (size_t r = 0; r < c.exclude.size(); ++r)
-      if (regionContains(c.exclude[r], p)) return {FilterReason::Exclude, uint32_t(r)};
-    return {};
+      if (regionContains(c.exclude[r], p)) return int(r);
+    return -1;
   };
   if (c.ends_only) {
     for (const float* p : {xyz, xyz + 3 * (n - 1)})
-      if (!visit(p)) return excludedBy(p);
+      if (const int r = visit(p); r >= 0) return {FilterReason::Exclude, uint32_t(r)};
   } else {
     for (size_t i = 0; i < n; ++i)
-      if (!visit(xyz + 3 * i)) return excludedBy(xyz + 3 * i);
+      if (const int r = visit(xyz + 3 * i); r >= 0) return {FilterReason::Exclude, uint32_t(r)};
   }
-  for (size_t r = 0; r < reached.size(); ++r)
-    if (!reached[r]) return {FilterReason::Include, uint32_t(r)};
+  for (size_t r = 0; r < c.include.size(); ++r)
+    if (!(reached >> r & 1u)) return {FilterReason::Include, uint32_t(r)};
   if (!in_order || next != c.include_ordered.size())
     return {FilterReason::IncludeOrdered, uint32_t(in_order ? next : 0)};
   return {};

@@ -53,7 +53,9 @@ float headerStepSize(const TractogramHeader& header);
 
 class FiberFilter {
  public:
-  // Throws Error for a min length above the max length or a negative one.
+  static constexpr size_t kMaxRegions = 64;  // of each kind
+  // Throws Error for a min length above the max length or a negative one,
+  // or more than kMaxRegions regions of a kind.
   FiberFilter(FilterCriteria criteria, float step_size_mm = NAN);
   const FilterCriteria& criteria() const { return criteria_; }
 
