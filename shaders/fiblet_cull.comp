@@ -167,6 +167,16 @@ bool sphereOccluded(CameraBlock cam, vec3 c, float r) {
   return farthest < nearest - kCullDepthSlack;
 }
 
+// The fiber filter kept the fiblet's fiber (or there is no filter). A
+// dropped fiber's fiblets are never drawn, so in phase 2 their visible
+// bits stay clear and the pyramid holds only kept fibers' depths: culling
+// stays exact whatever the filter did between frames.
+bool fibletKept(FibletDataset ds, uint fiblet) {
+  if (pc.kept == 0ul) return true;
+  const uint fiber = pc.fiber_base + UintsRef(ds.fiblet_fiber).values[fiblet];
+  return (BitsRef(pc.kept).words[fiber >> 5u] & (1u << (fiber & 31u))) != 0u;
+}
+
 void main() {
   const uint local = gl_LocalInvocationIndex;
   if (local < 2u) {
@@ -183,9 +193,11 @@ void main() {
   bool visible = false;
   vec3 c;
   float r;
-  if (fiblet < ds.fiblet_count && fibletSphere(ds, fiblet, c, r)) {
+  if (fiblet < ds.fiblet_count && fibletKept(ds, fiblet) && fibletSphere(ds, fiblet, c, r)) {
     const CameraBlock cam = CameraRef(pc.camera).camera;
-    if (sphereInFrustum(cam, c, r)) {
+    if (pc.mode == kCullKeptOnly) {
+      target = 0;
+    } else if (sphereInFrustum(cam, c, r)) {
       bool draw = true;
       if (pc.mode != kCullFrustum) {
         const bool was_visible = (bits.words[fiblet >> 5u] & (1u << (fiblet & 31u))) != 0u;

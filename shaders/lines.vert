@@ -32,6 +32,10 @@ void main() {
   const uint64_t j = first - c.first_point + uint64_t(vertex);
   const vec3 p = rawChunkPoint(c, j);
   gl_Position = cameraTransformPoint(CameraRef(pc.camera).camera.view_projection, p);
+  // A streamline the fiber filter dropped: every vertex beyond the far
+  // plane, so the clipper removes each of its segments whole.
+  if (pc.kept != 0ul && ((UintsRef(pc.kept).values[fiber >> 5u] >> (fiber & 31u)) & 1u) == 0u)
+    gl_Position = vec4(0.0, 0.0, 2.0, 1.0);
   // The segment vertex -> vertex + 1; the last vertex of a strip provokes
   // no segment.
   uint tangent = 0u;

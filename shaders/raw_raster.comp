@@ -31,6 +31,10 @@ void main() {
   const uint64_t j = group * uint64_t(gl_WorkGroupSize.x) + uint64_t(gl_LocalInvocationID.x);
   if (j + 1ul >= c.point_count) return;
   if (rawChunkPointEndsStreamline(c, j)) return;
+  if (pc.kept_points != 0ul) {
+    const uint64_t i = c.first_point + j;
+    if (((UintsRef(pc.kept_points).values[uint(i >> 5ul)] >> uint(i & 31ul)) & 1u) == 0u) return;
+  }
   const CameraBlock cam = CameraRef(pc.camera).camera;
   rasterSegment(VisibilityRef(pc.visibility), cam, rawChunkPoint(c, j), rawChunkPoint(c, j + 1ul), c.first_point + j);
 }

@@ -33,6 +33,10 @@ SHADER_NAMESPACE_BEGIN
 CULL_CONST uint kCullFrustum = 0u;  // dilated frustum + LoD, no occlusion (CullingMode::Frustum)
 CULL_CONST uint kCullPhase1 = 1u;   // ... restricted to fiblets whose visible bit is set
 CULL_CONST uint kCullPhase2 = 2u;   // ... + pyramid test, rewrites the visible bits, skips phase-1 fiblets
+// Every fiblet of a kept fiber to the full list, no frustum or LoD
+// (CullingMode::None while a fiber filter is on). Every mode skips the
+// fiblets of fibers the filter dropped (FibletCullPush::kept).
+CULL_CONST uint kCullKeptOnly = 3u;
 
 // The largest pyramid: 16384 px per side (createFrameTargets' limit) has 15
 // levels.
@@ -76,10 +80,14 @@ struct FibletCullPush {
   // still owns its two words when several datasets share the buffer.
   uint64_t visible;
   uint64_t pyramid;   // float, every level of the max-depth pyramid (kCullPhase2)
+  // The fiber filter's kept bits over the scene's fibers
+  // (select/gpu/gpu_fiber_filter.h), or 0: every fiber kept. The dataset's
+  // fiber f is the scene's fiber_base + f.
+  uint64_t kept;
   uint mode;          // kCull*
   float lod_pixels;   // LoD below this projected diameter in px; 0: off
   float focal_px;     // projection scale in px: |P[1][1]| * height / 2
-  uint pad;
+  uint fiber_base;
 };
 
 // fiblet_bounds.comp: one invocation per fiblet (kCullGroupSize per group)
@@ -162,7 +170,7 @@ SHADER_FN uint pyramidLevelOffset(uint width, uint height, uint level) {
 SHADER_NAMESPACE_END
 
 #ifdef __cplusplus
-static_assert(sizeof(fibscope::shader::FibletCullPush) == 64, "");
+static_assert(sizeof(fibscope::shader::FibletCullPush) == 72, "");
 static_assert(sizeof(fibscope::shader::FibletBoundsPush) == 16, "");
 static_assert(sizeof(fibscope::shader::FibletListFinalizePush) == 16, "");
 static_assert(sizeof(fibscope::shader::DepthPyramidPush) == 32, "");

@@ -72,6 +72,9 @@ struct RawRasterPush {
   uint64_t tractogram;  // RawTractogram block
   uint64_t camera;      // CameraBlock
   uint64_t visibility;  // uint64_t key per pixel; payload = global index of the segment's first point
+  // The fiber filter's bit per point (GpuScene::kept_point_bits): a
+  // segment is drawn when its first point's bit is set; 0: all drawn.
+  uint64_t kept_points;
   uint chunk;           // the chunk this dispatch rasterises
   uint pad0;
 };
@@ -89,6 +92,7 @@ struct RawResolvePush {
 struct LinesPush {
   uint64_t tractogram;
   uint64_t camera;
+  uint64_t kept;  // the fiber filter's kept bits over the streamlines (GpuScene::kept_bits); 0: all drawn
   uint chunk;
   uint pad0;
 };
@@ -100,9 +104,9 @@ static_assert(sizeof(fibscope::shader::RawChunk) == 40, "a raw chunk entry is 40
 static_assert(offsetof(fibscope::shader::RawChunk, first_streamline) == 32, "scalars follow the 64-bit members");
 static_assert(sizeof(fibscope::shader::RawTractogram) == 48, "the raw tractogram block is 48 bytes in std430");
 static_assert(offsetof(fibscope::shader::RawTractogram, streamline_count) == 40, "scalars follow the addresses");
-static_assert(sizeof(fibscope::shader::RawRasterPush) == 32, "");
+static_assert(sizeof(fibscope::shader::RawRasterPush) == 40, "");
 static_assert(sizeof(fibscope::shader::RawResolvePush) == 32, "");
-static_assert(sizeof(fibscope::shader::LinesPush) == 24, "");
+static_assert(sizeof(fibscope::shader::LinesPush) == 32, "");
 #endif
 
 #endif  // FIBSCOPE_SHADERS_SHARED_RAW_TRACTOGRAM_H

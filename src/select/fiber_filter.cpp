@@ -51,7 +51,11 @@ FiberFilter::FiberFilter(FilterCriteria criteria, float step_size_mm) : criteria
 }
 
 FilterVerdict FiberFilter::evaluate(const float* xyz, size_t n) const {
-  const float length = lengthInFloat(xyz, n);
+  return evaluate(xyz, n, lengthInFloat(xyz, n));
+}
+
+FilterVerdict FiberFilter::evaluate(const float* xyz, size_t n, float length) const {
+  if (n == 0) length = NAN;
   if (!(length >= min_length_ && length <= max_length_)) return {FilterReason::Length, 0};
   const FilterCriteria& c = criteria_;
   if (c.include.empty() && c.include_ordered.empty() && c.exclude.empty()) return {};

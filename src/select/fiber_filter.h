@@ -61,6 +61,13 @@ class FiberFilter {
 
   // The verdict for the streamline of n points (x, y, z interleaved).
   FilterVerdict evaluate(const float* xyz, size_t n) const;
+  // The same with its length given (mm; NaN drops it) instead of summed
+  // from the points: the GPU filter reads the lengths computed at upload,
+  // and its tests compare with this.
+  FilterVerdict evaluate(const float* xyz, size_t n, float length_mm) const;
+  // The length limits with the margin (-inf / +inf without a limit).
+  float minLength() const { return min_length_; }
+  float maxLength() const { return max_length_; }
 
  private:
   FilterCriteria criteria_;

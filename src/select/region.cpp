@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "select/packed_region.h"
 
 namespace fibscope {
 namespace {
@@ -38,21 +39,20 @@ std::string number(double v) {
 bool regionContains(const Region& region, const float* p) {
   if (const auto* s = std::get_if<SphereRegion>(&region)) {
     // As MRtrix3's ROI::contains: (pos - p).squaredNorm() <= radius^2, in float.
-    const float dx = s->center[0] - p[0], dy = s->center[1] - p[1], dz = s->center[2] - p[2];
-    return (dx * dx + dy * dy) + dz * dz <= s->radius * s->radius;
+    // (The GPU filter's test: shared/fiber_filter.h.)
+    return shader::filterSphereContains(s->center[0], s->center[1], s->center[2], s->radius,
+                                        shader::vec3(p[0], p[1], p[2]));
   }
   if (const auto* b = std::get_if<BoxRegion>(&region)) {
     for (int k = 0; k < 3; ++k)
       if (!(p[k] >= b->min[k] && p[k] <= b->max[k])) return false;
     return true;
   }
-  const auto& o = std::get<OrientedBoxRegion>(region);
-  const glm::dvec3 d = glm::dvec3(p[0], p[1], p[2]) - glm::dvec3(o.center[0], o.center[1], o.center[2]);
-  for (int k = 0; k < 3; ++k) {
-    const glm::dvec3 axis(o.axes[k][0], o.axes[k][1], o.axes[k][2]);
-    if (!(std::fabs(glm::dot(d, axis)) <= o.half[k])) return false;
-  }
-  return true;
+  // In float, as the GPU filter tests it (shared/fiber_filter.h): both
+  // sides decide a vertex on a face alike.
+  const OrientedBoxFloats f = orientedBoxFloats(std::get<OrientedBoxRegion>(region));
+  return shader::filterOrientedBoxContains(f.center, f.half_size, f.axes[0], f.axes[1], f.axes[2],
+                                           shader::vec3(p[0], p[1], p[2]));
 }
 
 Region parseRegion(std::string_view spec) {

@@ -45,8 +45,9 @@ void resetLists(VkCommandBuffer cmd, const CullBuffers& buffers) {
 }
 
 void recordCull(VkCommandBuffer cmd, const gpu::VulkanContext& context, const CullPasses& passes,
-                const GpuDataset& dataset, const CullRegion& region, const GpuFrameTargets& frame,
+                const SceneEntry& entry, const CullRegion& region, const GpuFrameTargets& frame,
                 const CullBuffers& buffers, uint32_t mode, const CullFrame& cull) {
+  const GpuDataset& dataset = *entry.dataset;
   const uint64_t fiblets = dataset.block().fiblet_count;
   if (fiblets == 0) return;
   shader::FibletCullPush push{};
@@ -56,6 +57,8 @@ void recordCull(VkCommandBuffer cmd, const gpu::VulkanContext& context, const Cu
   push.lod_list = buffers.lod_list.address + region.list_offset;
   push.visible = buffers.visible.address + region.visible_offset;
   push.pyramid = buffers.pyramid.address;
+  push.kept = cull.kept_bits;
+  push.fiber_base = entry.fiber_base;
   push.mode = mode;
   push.lod_pixels = cull.lod_pixels;
   push.focal_px = cull.focal_px;
@@ -104,7 +107,7 @@ void recordPhase(VkCommandBuffer cmd, const gpu::VulkanContext& context, const C
     resetLists(cmd, buffers);
     gpu::recordBarrier(cmd, gpu::kTransferToCompute);
     for (size_t i = 0; i < scene.entries.size(); ++i)
-      recordCull(cmd, context, passes, *scene.entries[i].dataset, buffers.regions[i], frame, buffers, mode, cull);
+      recordCull(cmd, context, passes, scene.entries[i], buffers.regions[i], frame, buffers, mode, cull);
     gpu::computeToComputeBarrier(cmd);
     recordFinalize(cmd, context, passes, buffers, fiblet_passes);
   }
@@ -256,9 +259,11 @@ void recordCulledRaster(VkCommandBuffer cmd, const gpu::VulkanContext& context, 
   vkCmdFillBuffer(cmd, buffers.stats.buffer, 0, VK_WHOLE_SIZE, 0);
   if (reset_history) vkCmdFillBuffer(cmd, buffers.visible.buffer, 0, VK_WHOLE_SIZE, 0xFFFFFFFFu);
 
-  recordPhase(cmd, context, passes, fiblet_passes, scene, frame, buffers,
-              two_phase ? shader::kCullPhase1 : shader::kCullFrustum, cull, timer, two_phase ? "cull 1" : "cull",
-              two_phase ? "raster 1" : "raster");
+  const uint32_t first_mode = two_phase                           ? shader::kCullPhase1
+                              : cull.mode == CullingMode::Frustum ? shader::kCullFrustum
+                                                                  : shader::kCullKeptOnly;
+  recordPhase(cmd, context, passes, fiblet_passes, scene, frame, buffers, first_mode, cull, timer,
+              two_phase ? "cull 1" : "cull", two_phase ? "raster 1" : "raster");
   if (two_phase) {
     // (The phase-1 raster's writes before the pyramid: its pass's barrier.)
     // Its reads of the lists before their counts are copied and reset.

@@ -97,9 +97,12 @@ void recordDepthPyramid(VkCommandBuffer cmd, const CullPasses& passes, const Gpu
 
 // What recordCulledRaster needs besides the buffers.
 struct CullFrame {
-  CullingMode mode = CullingMode::Frustum;  // Frustum or TwoPhase
+  // Frustum or TwoPhase; None: no test but the fiber filter's (every
+  // fiblet of a kept fiber drawn at full detail).
+  CullingMode mode = CullingMode::Frustum;
   float lod_pixels = 0;                     // 0: no LoD
   float focal_px = 0;                       // cullFocalPixels(camera)
+  VkDeviceAddress kept_bits = 0;            // GpuScene::kept_bits: the filter's fibers only; 0: all
 };
 
 // |P[1][1]| * height / 2: a length l at view distance z projects to

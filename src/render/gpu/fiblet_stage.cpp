@@ -58,7 +58,9 @@ class FibletStage final : public FrameStage {
       prepareTangentCache(frame.context, frame.targets, layout.fiblets);
       tangent_cache_for_ = layout.fiblets;
     }
-    culled_ = settings.culling != CullingMode::None && layout.fiblets > 0;
+    // With a fiber filter even CullingMode::None goes through the cull
+    // pass: it is where dropped fibers' fiblets are skipped.
+    culled_ = (settings.culling != CullingMode::None || frame.scene.kept_bits != 0) && layout.fiblets > 0;
     if (settings.culling == CullingMode::TwoPhase) {
       // The occlusion test wants each dataset's exact spheres: computed in
       // this frame for a dataset that has none yet (frustum culling keeps
@@ -79,7 +81,9 @@ class FibletStage final : public FrameStage {
       for (const SceneEntry& e : layout.entries) fiblets.push_back(e.dataset->block().fiblet_count);
       prepareCullBuffers(frame.context, cull_buffers_, fiblets, frame.targets.width, frame.targets.height);
       recordCulledRaster(frame.cmd, frame.context, cull_passes_, fiblet_passes_, layout, frame.targets, cull_buffers_,
-                         CullFrame{settings.culling, settings.lod_pixels, cullFocalPixels(frame.camera)}, frame.timer);
+                         CullFrame{settings.culling, settings.culling == CullingMode::None ? 0.0f : settings.lod_pixels,
+                                   cullFocalPixels(frame.camera), frame.scene.kept_bits},
+                         frame.timer);
     } else {
       gpu::PassScope pass(frame.cmd, frame.timer, "raster", gpu::kComputeToCompute);
       for (const SceneEntry& e : layout.entries)

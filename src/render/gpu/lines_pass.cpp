@@ -72,7 +72,8 @@ float linesDrawnWidth(const gpu::VulkanContext& context, float requested_px) {
 }
 
 void recordLines(VkCommandBuffer cmd, const gpu::VulkanContext& context, LinesPass& pass,
-                 const GpuRawTractogram& tractogram, const GpuFrameTargets& frame, float line_width_px) {
+                 const GpuRawTractogram& tractogram, const GpuFrameTargets& frame, float line_width_px,
+                 VkDeviceAddress kept_bits) {
   // The previous frame's copy read the colour attachment: finish it before
   // the clear overwrites it (write-after-read, an execution dependency).
   gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COPY_BIT, 0, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, 0);
@@ -86,6 +87,7 @@ void recordLines(VkCommandBuffer cmd, const gpu::VulkanContext& context, LinesPa
     shader::LinesPush push{};
     push.tractogram = tractogram.blockAddress();
     push.camera = frame.camera.address;
+    push.kept = kept_bits;
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pass.pipeline.pipeline);
     vkCmdSetLineWidth(cmd, linesDrawnWidth(context, line_width_px));
     // Chunk by chunk, the chunk in the push constants (the vertex shader

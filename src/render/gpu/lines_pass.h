@@ -53,11 +53,13 @@ void releaseLinesAttachments(const gpu::VulkanContext& context, LinesPass& pass)
 // width range and rounded to its granularity with wideLines, else 1.
 float linesDrawnWidth(const gpu::VulkanContext& context, float requested_px);
 
-// Clears the attachments, draws every streamline and copies the colour
+// Clears the attachments, draws every streamline (the fiber filter's kept
+// ones: `kept_bits`, GpuScene::kept_bits, 0 for all) and copies the colour
 // attachment into frame.gbuffer (written at the TRANSFER stage when this
 // returns). The attachments must be the frame's size, the camera block in
 // frame.camera visible to vertex-shader reads.
 void recordLines(VkCommandBuffer cmd, const gpu::VulkanContext& context, LinesPass& pass,
-                 const GpuRawTractogram& tractogram, const GpuFrameTargets& frame, float line_width_px);
+                 const GpuRawTractogram& tractogram, const GpuFrameTargets& frame, float line_width_px,
+                 VkDeviceAddress kept_bits = 0);
 
 }  // namespace fibscope

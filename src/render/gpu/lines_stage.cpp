@@ -36,7 +36,8 @@ class LinesStage final : public FrameStage {
     const gpu::PassBarrier after{VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, gpu::kStorageReadWrite};
     gpu::PassScope pass(frame.cmd, frame.timer, "lines", after);
-    recordLines(frame.cmd, frame.context, pass_, *frame.scene.raw, frame.targets, frame.settings.line_width_px);
+    recordLines(frame.cmd, frame.context, pass_, *frame.scene.raw, frame.targets, frame.settings.line_width_px,
+                frame.scene.kept_bits);
   }
 
  private:

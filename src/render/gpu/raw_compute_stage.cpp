@@ -27,7 +27,7 @@ class RawComputeStage final : public FrameStage {
     frame.stats.segments_total = frame.scene.raw->segmentCount();
     {
       gpu::PassScope pass(frame.cmd, frame.timer, "raster", gpu::kComputeToCompute);
-      recordRawRaster(frame.cmd, frame.context, passes_, *frame.scene.raw, frame.targets);
+      recordRawRaster(frame.cmd, frame.context, passes_, *frame.scene.raw, frame.targets, frame.scene.kept_point_bits);
     }
     gpu::PassScope pass(frame.cmd, frame.timer, "resolve", gpu::kComputeToCompute);
     recordRawResolve(frame.cmd, passes_, *frame.scene.raw, frame.targets);

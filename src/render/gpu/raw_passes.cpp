@@ -26,7 +26,7 @@ void destroyRawPasses(const gpu::VulkanContext& context, RawPasses& passes) {
 }
 
 void recordRawRaster(VkCommandBuffer cmd, const gpu::VulkanContext& context, const RawPasses& passes,
-                     const GpuRawTractogram& tractogram, const GpuFrameTargets& frame) {
+                     const GpuRawTractogram& tractogram, const GpuFrameTargets& frame, VkDeviceAddress kept_points) {
   // One dispatch per chunk over its candidate segments j -> j + 1, j <
   // points - 1; the shader skips those that join two streamlines. The
   // dispatches only meet in atomic minima on the visibility buffer, so they
@@ -35,6 +35,7 @@ void recordRawRaster(VkCommandBuffer cmd, const gpu::VulkanContext& context, con
   push.tractogram = tractogram.blockAddress();
   push.camera = frame.camera.address;
   push.visibility = frame.visibility.address;
+  push.kept_points = kept_points;
   for (uint32_t c = 0; c < tractogram.chunkCount(); ++c) {
     const uint64_t points = tractogram.chunk(c).entry.point_count;
     if (points < 2) continue;

@@ -26,10 +26,11 @@ struct RawPasses {
 RawPasses createRawPasses(const gpu::VulkanContext& context);
 void destroyRawPasses(const gpu::VulkanContext& context, RawPasses& passes);
 
-// Every segment: one dispatch per chunk of points, kRawRasterGroupSize
-// invocations per workgroup on a 2D grid.
+// Every segment (of the fiber filter's kept streamlines: `kept_points`,
+// GpuScene::kept_point_bits, 0 for all): one dispatch per chunk of points,
+// kRawRasterGroupSize invocations per workgroup on a 2D grid.
 void recordRawRaster(VkCommandBuffer cmd, const gpu::VulkanContext& context, const RawPasses& passes,
-                     const GpuRawTractogram& tractogram, const GpuFrameTargets& frame);
+                     const GpuRawTractogram& tractogram, const GpuFrameTargets& frame, VkDeviceAddress kept_points = 0);
 void recordRawResolve(VkCommandBuffer cmd, const RawPasses& passes, const GpuRawTractogram& tractogram,
                       const GpuFrameTargets& frame);
 

@@ -35,6 +35,13 @@ struct GpuScene {
   VkDeviceAddress fiber_scalars = 0;   // float per fiber (ColorMode::Scalar)
   VkDeviceAddress selection_bits = 0;  // uint words: fiber f selected when bit f % 32 of word f / 32 is set;
                                        // 0 also means an empty selection (nothing dimmed)
+  // The fiber filter (select/gpu/gpu_fiber_filter.h): its kept bits over
+  // the scene's fibers (the layout's for compute, the raw tractogram's
+  // streamlines for the baselines), and for the raw-compute baseline a bit
+  // per raw point. 0: every fiber drawn. Dropped fibers are not drawn at
+  // all (no pixel, no pick).
+  VkDeviceAddress kept_bits = 0;
+  VkDeviceAddress kept_point_bits = 0;
   // Analytic spheres (world mm) drawn as surfaces with the lines, at most
   // shader::kMaxSurfaceSpheres; their ids land in the G-buffer's fiber field.
   std::vector<shader::SurfaceSphere> spheres;

@@ -1,0 +1,60 @@
+// The regions of the fiber filter's passes (shared/fiber_filter.h): a
+// vertex tested against one region, and against every hit region at once.
+#ifndef FIBSCOPE_GLSL_FILTER_REGIONS_GLSL
+#define FIBSCOPE_GLSL_FILTER_REGIONS_GLSL
+
+#include "shared/fiber_filter.h"
+
+layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer FilterRegionsRef { FilterRegion regions[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer FilterHitsRef { uvec4 hits[]; };
+layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer FilterMaskRef { uint words[]; };
+
+// kFilterMask: the voxel nearest to p (world -> voxel, then rounded
+// half up: floor(v + 0.5), as the CPU's maskContains); outside the image
+// is outside.
+bool filterMaskContains(FilterRegion r, vec3 p) {
+  precise float vx = ((r.v[0] * p.x + r.v[1] * p.y) + r.v[2] * p.z) + r.v[3];
+  precise float vy = ((r.v[4] * p.x + r.v[5] * p.y) + r.v[6] * p.z) + r.v[7];
+  precise float vz = ((r.v[8] * p.x + r.v[9] * p.y) + r.v[10] * p.z) + r.v[11];
+  precise float rx = floor(vx + 0.5), ry = floor(vy + 0.5), rz = floor(vz + 0.5);
+  if (!(rx >= 0.0 && ry >= 0.0 && rz >= 0.0 && rx < float(r.nx) && ry < float(r.ny) && rz < float(r.nz))) return false;
+  const uint i = uint(rx) + r.nx * (uint(ry) + r.ny * uint(rz));
+  return ((FilterMaskRef(r.mask).words[i >> 5u] >> (i & 31u)) & 1u) != 0u;
+}
+
+bool filterRegionContains(FilterRegion r, vec3 p) {
+  if (r.kind == kFilterSphere) return filterSphereContains(r.v[0], r.v[1], r.v[2], r.v[3], p);
+  if (r.kind == kFilterBox) return filterBoxContains(r.v[0], r.v[1], r.v[2], r.v[3], r.v[4], r.v[5], p);
+  if (r.kind == kFilterOrientedBox)
+    return filterOrientedBoxContains(vec3(r.v[0], r.v[1], r.v[2]), vec3(r.v[3], r.v[4], r.v[5]),
+                                     vec3(r.v[6], r.v[7], r.v[8]), vec3(r.v[9], r.v[10], r.v[11]),
+                                     vec3(r.v[12], r.v[13], r.v[14]), p);
+  return filterMaskContains(r, p);
+}
+
+// The hit regions (the first `count` of `regions`) p lies in, as bits.
+uvec2 filterHitBits(FilterRegionsRef regions, uint count, vec3 p) {
+  uvec2 bits = uvec2(0u);
+  for (uint i = 0u; i < count; ++i)
+    if (filterRegionContains(regions.regions[i], p)) {
+      if (i < 32u) bits.x |= 1u << i;
+      else bits.y |= 1u << (i - 32u);
+    }
+  return bits;
+}
+
+// The ordered includes' walk (FiberFilter::evaluate): the first ordered
+// region p lies in must be the next one to enter or the one entered last.
+// state: x = next to enter, y = 1 while in order.
+uvec2 filterOrderedStep(FilterRegionsRef regions, uint first, uint count, vec3 p, uvec2 state) {
+  if (state.y == 0u) return state;
+  for (uint k = 0u; k < count; ++k)
+    if (filterRegionContains(regions.regions[first + k], p)) {
+      if (k == state.x) state.x += 1u;
+      else if (k + 1u != state.x) state.y = 0u;
+      break;
+    }
+  return state;
+}
+
+#endif

@@ -1,0 +1,276 @@
+// The fiber filter on the GPU (select/gpu/gpu_fiber_filter.h): its kept
+// bits equal the CPU filter's verdicts (select/fiber_filter.h, tckedit's
+// semantics) fiber for fiber, on the fiblets' decoded points (the CPU
+// decoder's sequential order) and on a raw tractogram's own points, for
+// spheres, boxes, oriented boxes, ends-only, ordered includes and length
+// limits; and the renderer draws only kept fibers in every pipeline, with
+// two-phase culling still exact while the filter changes between frames.
+// Validation layers on (GpuTest fails on any message).
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "codec/fiblet_decoder.h"
+#include "codec/fiblet_encoder.h"
+#include "gpu/buffer.h"
+#include "gpu_render_test_support.h"
+#include "gpu_test_context.h"
+#include "render/camera.h"
+#include "render/gpu/frame_renderer.h"
+#include "render/gpu/raw_tractogram.h"
+#include "render/gpu/tractogram_upload.h"
+#include "select/fiber_filter.h"
+#include "select/gpu/gpu_fiber_filter.h"
+#include "select/region.h"
+
+namespace fibscope {
+namespace {
+
+bool bitSet(const std::vector<uint32_t>& words, size_t i) { return (words[i / 32] >> (i % 32) & 1u) != 0; }
+
+// A named set of criteria placed relative to the phantom's box.
+struct Case {
+  std::string name;
+  FilterCriteria criteria;
+};
+
+std::string num(double v) { return std::to_string(v); }
+
+std::vector<Case> casesFor(const Bounds& b) {
+  const double cx = 0.5 * (b.min[0] + b.max[0]), cy = 0.5 * (b.min[1] + b.max[1]), cz = 0.5 * (b.min[2] + b.max[2]);
+  const double ex = b.max[0] - b.min[0], ey = b.max[1] - b.min[1], ez = b.max[2] - b.min[2];
+  auto sphere = [&](double fx, double fy, double fz, double fr) {
+    return parseRegion("sphere:" + num(cx + fx * ex) + "," + num(cy + fy * ey) + "," + num(cz + fz * ez) + "," +
+                       num(fr * ex));
+  };
+  auto box = [&](double fx0, double fy0, double fz0, double fx1, double fy1, double fz1) {
+    return parseRegion("box:" + num(cx + fx0 * ex) + "," + num(cy + fy0 * ey) + "," + num(cz + fz0 * ez) + "," +
+                       num(cx + fx1 * ex) + "," + num(cy + fy1 * ey) + "," + num(cz + fz1 * ez));
+  };
+  const Region obox = parseRegion("obox:" + num(cx) + "," + num(cy + 0.1 * ey) + "," + num(cz) + "," + num(0.5 * ex) +
+                                  "," + num(0.15 * ey) + "," + num(0.2 * ez) + ",20,-35,50");
+  std::vector<Case> cases;
+  auto add = [&](std::string name, auto&& fill) {
+    Case c{std::move(name), {}};
+    fill(c.criteria);
+    cases.push_back(std::move(c));
+  };
+  add("include sphere", [&](FilterCriteria& c) { c.include = {sphere(0, 0, 0.1, 0.12)}; });
+  add("include sphere, exclude box", [&](FilterCriteria& c) {
+    c.include = {sphere(0, 0, 0.1, 0.15)};
+    c.exclude = {box(-0.5, -0.5, -0.5, 0.5, -0.1, 0.5)};
+  });
+  add("two includes", [&](FilterCriteria& c) { c.include = {sphere(0, 0, 0.1, 0.15), box(-0.5, -0.5, 0.3, 0.5, 0.5, 0.5)}; });
+  add("oriented box", [&](FilterCriteria& c) { c.include = {obox}; });
+  add("ends only", [&](FilterCriteria& c) {
+    c.include = {box(-0.5, -0.5, 0.1, 0.5, 0.5, 0.5)};
+    c.ends_only = true;
+  });
+  add("ordered includes", [&](FilterCriteria& c) {
+    c.include_ordered = {box(-0.5, -0.5, 0.2, 0.5, 0.5, 0.5), box(-0.5, -0.5, -0.5, 0.5, 0.5, -0.1)};
+  });
+  add("ordered, ends only, exclude", [&](FilterCriteria& c) {
+    c.include_ordered = {box(-0.5, -0.5, 0.0, 0.5, 0.5, 0.5), box(-0.5, -0.5, -0.5, 0.5, 0.5, 0.0)};
+    c.exclude = {sphere(0.3, 0, 0, 0.1)};
+    c.ends_only = true;
+  });
+  add("length limits", [&](FilterCriteria& c) {
+    c.min_length_mm = 0.4 * ex;
+    c.max_length_mm = 0.9 * ex;
+  });
+  add("length and exclude", [&](FilterCriteria& c) {
+    c.min_length_mm = 0.3 * ex;
+    c.exclude = {sphere(0, 0, 0, 0.1)};
+  });
+  return cases;
+}
+
+class GpuFiberFilterTest : public test::GpuTest {
+ protected:
+  void SetUp() override {
+    test::GpuTest::SetUp();
+    if (IsSkipped()) return;
+    fibers_ = test::renderPhantom(400, 5);
+    bounds_ = tractogramBounds(fibers_);
+    upload_ = std::make_unique<TractogramUpload>(uploadTractogram(context(), fibers_, "phantom"));
+    // The points the GPU filter sees: the serial decode (the CPU decoder's
+    // sequential order), and the lengths the dataset was uploaded with.
+    const EncodedFiblets encoded = encodeTractogram(fibers_, upload_->params);
+    decoded_ = FibletDecoder(upload_->params).decodeAll(encoded, DecodeOrder::Sequential);
+    lengths_ = streamlineLengths(fibers_);
+    filter_ = std::make_unique<GpuFiberFilter>(context());
+  }
+  void TearDown() override {
+    filter_.reset();
+    upload_.reset();
+    test::GpuTest::TearDown();
+  }
+  FilterFibletSource source() const {
+    const GpuDataset& d = upload_->dataset;
+    return {d.blockAddress(), d.block().fiblet_count, d.block().fiber_count, 0, d.fiberLength().address};
+  }
+  // Fibers where the GPU's bit and the CPU's verdict on `points` differ.
+  static size_t mismatches(const std::vector<uint32_t>& words, const FiberFilter& cpu, const Tractogram& points,
+                           const std::vector<float>& lengths, size_t& kept) {
+    size_t differ = 0;
+    kept = 0;
+    for (size_t f = 0; f < points.streamlineCount(); ++f) {
+      const bool want = cpu.evaluate(points.point(points.offsets[f]), points.pointsIn(f), lengths[f]).kept();
+      kept += want;
+      if (want != bitSet(words, f)) ++differ;
+    }
+    return differ;
+  }
+
+  Tractogram fibers_, decoded_;
+  Bounds bounds_;
+  std::vector<float> lengths_;
+  std::unique_ptr<TractogramUpload> upload_;
+  std::unique_ptr<GpuFiberFilter> filter_;
+};
+
+TEST_F(GpuFiberFilterTest, keptBitsOfFibletsEqualTheCpuFilterOnTheDecodedPoints) {
+  ASSERT_EQ(decoded_.streamlineCount(), fibers_.streamlineCount());
+  const FilterFibletSource src = source();
+  for (const Case& c : casesFor(bounds_)) {
+    SCOPED_TRACE(c.name);
+    const FiberFilter cpu(c.criteria, 0.1f);
+    ASSERT_TRUE(filter_->update(cpu, std::span(&src, 1), src.fibers));
+    const std::vector<uint32_t> words = filter_->keptWords();
+    ASSERT_EQ(words.size(), (src.fibers + 31) / 32);
+    size_t kept = 0;
+    EXPECT_EQ(mismatches(words, cpu, decoded_, lengths_, kept), 0u);
+    EXPECT_EQ(filter_->keptCount(), kept);
+    // Each case keeps some fibers and drops others, so it could fail.
+    EXPECT_GT(kept, 0u);
+    EXPECT_LT(kept, fibers_.streamlineCount());
+    std::printf("%-28s kept %zu of %zu fibers, %.2f ms on the GPU\n", c.name.c_str(), kept, fibers_.streamlineCount(),
+                filter_->lastGpuMilliseconds());
+  }
+}
+
+TEST_F(GpuFiberFilterTest, keptBitsOfARawTractogramEqualTheCpuFilterOnTheFilesPoints) {
+  const GpuRawTractogram raw = GpuRawTractogram::upload(context(), fibers_, "phantom");
+  gpu::Buffer lengths = gpu::createBuffer(context(), lengths_.size() * sizeof(float), gpu::MemoryUse::DeviceLocal);
+  gpu::uploadToBuffer(context(), lengths, lengths_.data(), lengths_.size() * sizeof(float));
+  const FilterRawSource src{raw.blockAddress(), raw.streamlineCount(), raw.pointCount(), lengths.address};
+  for (const Case& c : casesFor(bounds_)) {
+    SCOPED_TRACE(c.name);
+    const FiberFilter cpu(c.criteria, 0.1f);
+    ASSERT_TRUE(filter_->update(cpu, src));
+    size_t kept = 0;
+    EXPECT_EQ(mismatches(filter_->keptWords(), cpu, fibers_, lengths_, kept), 0u);
+    EXPECT_EQ(filter_->keptCount(), kept);
+    EXPECT_GT(kept, 0u);
+    EXPECT_LT(kept, fibers_.streamlineCount());
+    EXPECT_NE(filter_->keptPointBits(), 0u);
+  }
+  gpu::destroyBuffer(context(), lengths);
+}
+
+TEST_F(GpuFiberFilterTest, updatesOnlyWhenACriterionChangesAndAnEmptyFilterKeepsAll) {
+  const FilterFibletSource src = source();
+  FilterCriteria c;
+  c.include = {parseRegion("sphere:0,0,0,20")};
+  EXPECT_TRUE(filter_->update(FiberFilter(c), std::span(&src, 1), src.fibers));
+  EXPECT_NE(filter_->keptBits(), 0u);
+  EXPECT_FALSE(filter_->update(FiberFilter(c), std::span(&src, 1), src.fibers)) << "same criteria: no GPU work";
+  c.include = {parseRegion("sphere:0,0,0,21")};
+  EXPECT_TRUE(filter_->update(FiberFilter(c), std::span(&src, 1), src.fibers)) << "a sphere grew";
+  EXPECT_TRUE(filter_->update(FiberFilter(FilterCriteria{}), std::span(&src, 1), src.fibers));
+  EXPECT_EQ(filter_->keptBits(), 0u) << "nothing to filter: everything drawn";
+  EXPECT_EQ(filter_->keptCount(), src.fibers);
+  // Too many regions for the GPU's 64 hit bits: an error, nothing kept half-way.
+  FilterCriteria many;
+  for (int i = 0; i < 40; ++i) many.include.push_back(parseRegion("sphere:0,0,0," + std::to_string(i + 1)));
+  for (int i = 0; i < 30; ++i) many.exclude.push_back(parseRegion("sphere:50,0,0," + std::to_string(i + 1)));
+  EXPECT_THROW(filter_->update(FiberFilter(many), std::span(&src, 1), src.fibers), Error);
+}
+
+// What a frame drew: per pixel the fiber (kNoFiberId where none).
+std::vector<uint32_t> drawnFibers(const gpu::VulkanContext& context, const FrameRenderer& renderer) {
+  std::vector<uint32_t> fibers;
+  for (const shader::GBufferTexel& t : downloadGBuffer(context, renderer.targets())) fibers.push_back(t.fiber);
+  return fibers;
+}
+
+TEST_F(GpuFiberFilterTest, everyPipelineDrawsOnlyKeptFibersAndTwoPhaseCullingStaysExact) {
+  constexpr uint32_t kSize = 128;
+  const Camera camera = orbitCamera(bounds_, 30, 20, kSize, kSize, 1.0);
+  const FilterFibletSource src = source();
+  const std::vector<Case> cases = casesFor(bounds_);
+  RenderSettings none, two_phase;
+  none.culling = CullingMode::None;
+  two_phase.culling = CullingMode::TwoPhase;
+  none.ssao = two_phase.ssao = false;
+  none.lod_pixels = two_phase.lod_pixels = 0;
+  FrameRenderer reference(context(), kSize, kSize), culled(context(), kSize, kSize);
+  size_t unfiltered_pixels = 0;
+  {
+    reference.render(camera, none, GpuScene{&upload_->dataset});
+    for (uint32_t f : drawnFibers(context(), reference)) unfiltered_pixels += f != shader::kNoFiberId;
+  }
+  // The culled renderer keeps its two-phase history across the filter's
+  // changes: the cases follow each other frame after frame.
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const FiberFilter cpu(c.criteria, 0.1f);
+    filter_->update(cpu, std::span(&src, 1), src.fibers);
+    const std::vector<uint32_t> words = filter_->keptWords();
+    GpuScene scene{&upload_->dataset};
+    scene.kept_bits = filter_->keptBits();
+    reference.render(camera, none, scene);
+    culled.render(camera, two_phase, scene);
+    const auto a = downloadVisibility(context(), reference.targets());
+    const auto b = downloadVisibility(context(), culled.targets());
+    size_t key_diff = 0;
+    for (size_t i = 0; i < a.size(); ++i) key_diff += a[i] != b[i];
+    EXPECT_EQ(key_diff, 0u) << "two-phase culling on versus off with the filter";
+    size_t drawn = 0, dropped_drawn = 0;
+    for (uint32_t f : drawnFibers(context(), reference)) {
+      if (f == shader::kNoFiberId) continue;
+      ++drawn;
+      dropped_drawn += !bitSet(words, f);
+    }
+    EXPECT_EQ(dropped_drawn, 0u) << "a dropped fiber was drawn";
+    EXPECT_LT(drawn, unfiltered_pixels);
+  }
+
+  // The baselines: the raw tractogram's kept bits, per streamline and per point.
+  const GpuRawTractogram raw = GpuRawTractogram::upload(context(), fibers_, "phantom");
+  gpu::Buffer lengths = gpu::createBuffer(context(), lengths_.size() * sizeof(float), gpu::MemoryUse::DeviceLocal);
+  gpu::uploadToBuffer(context(), lengths, lengths_.data(), lengths_.size() * sizeof(float));
+  const FilterRawSource raw_src{raw.blockAddress(), raw.streamlineCount(), raw.pointCount(), lengths.address};
+  const FiberFilter cpu(cases[1].criteria, 0.1f);
+  filter_->update(cpu, raw_src);
+  const std::vector<uint32_t> words = filter_->keptWords();
+  for (RenderPipeline pipeline : {RenderPipeline::RawCompute, RenderPipeline::Lines}) {
+    SCOPED_TRACE(pipeline == RenderPipeline::Lines ? "lines" : "raw-compute");
+    RenderSettings settings = none;
+    settings.pipeline = pipeline;
+    GpuScene scene{nullptr, &raw};
+    reference.render(camera, settings, scene);
+    size_t all = 0;
+    for (uint32_t f : drawnFibers(context(), reference)) all += f != shader::kNoFiberId;
+    scene.kept_bits = filter_->keptBits();
+    scene.kept_point_bits = filter_->keptPointBits();
+    reference.render(camera, settings, scene);
+    size_t drawn = 0, dropped_drawn = 0;
+    for (uint32_t f : drawnFibers(context(), reference)) {
+      if (f == shader::kNoFiberId) continue;
+      ++drawn;
+      dropped_drawn += !bitSet(words, f);
+    }
+    EXPECT_EQ(dropped_drawn, 0u);
+    EXPECT_GT(drawn, 0u);
+    EXPECT_LT(drawn, all);
+  }
+  gpu::destroyBuffer(context(), lengths);
+}
+
+}  // namespace
+}  // namespace fibscope
