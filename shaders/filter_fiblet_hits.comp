@@ -12,6 +12,7 @@
 
 #include "shared/workgroup.h"
 #include "glsl/fiblet_record.glsl"
+#include "glsl/filter_fiblet.glsl"
 #include "glsl/filter_regions.glsl"
 
 layout(local_size_x_id = WORKGROUP_SIZE_X_ID) in;  // kFilterGroupSize
@@ -48,6 +49,11 @@ void main() {
   }
   const uint w0 = records.words[base], w1 = records.words[base + 1u], w2 = records.words[base + 2u];
   const vec3 p0_n = fibletRecordPoint(w0, w1, w2, 0u);
+  // Most fiblets lie far from every region: decoding them would find nothing.
+  vec3 c;
+  float radius;
+  filterFibletSphere(ds, fiblet, count, p0_n, fibletRecordPoint(w0, w1, w2, 1u), c, radius);
+  if (!filterSphereNearAny(regions, 0u, pc.hit_regions, c, radius)) return;
   uvec2 bits = uvec2(0u);
   // Point 0 is the fiber's last too when it ends a fiber in a one-point fiblet.
   if (pc.ends_only == 0u || first_only || (last_only && count == 1u))

@@ -10,6 +10,7 @@
 
 #include "shared/workgroup.h"
 #include "glsl/fiblet_record.glsl"
+#include "glsl/filter_fiblet.glsl"
 #include "glsl/filter_regions.glsl"
 
 layout(local_size_x_id = WORKGROUP_SIZE_X_ID) in;  // kFilterGroupSize
@@ -30,17 +31,21 @@ void main() {
   const vec3 v = vec3(ds.v_x, ds.v_y, ds.v_z);
   DirectionsRef directions = DirectionsRef(ds.directions);
   uvec2 state = uvec2(0u, 1u);
-  bool any = false;
   for (uint fiblet = f0; fiblet < f1 && state.y != 0u; ++fiblet) {
     const uint base = fiblet * ds.record_words;
     const uint count = fibletCount(fibletRecordByte(records, base, fibletFlagsByte(n)));
     if (count < 1u || count > n) continue;
     const uint w0 = records.words[base], w1 = records.words[base + 1u], w2 = records.words[base + 2u];
     const vec3 p0_n = fibletRecordPoint(w0, w1, w2, 0u);
+    // A fiblet far from every ordered region leaves the walk as it is (its
+    // points lie in none of them).
+    vec3 c;
+    float radius;
+    filterFibletSphere(ds, fiblet, count, p0_n, fibletRecordPoint(w0, w1, w2, 1u), c, radius);
+    if (!filterSphereNearAny(regions, o, m, c, radius)) continue;
     const bool first_fiblet = fiblet == f0, last_fiblet = fiblet + 1u == f1;
     if (pc.ends_only == 0u || first_fiblet) {
       state = filterOrderedStep(regions, o, m, fibletToWorld(ds, p0_n), state);
-      any = true;
     }
     if (pc.ends_only != 0u && !last_fiblet) continue;
     if (count < 2u) {
@@ -54,6 +59,6 @@ void main() {
       if (pc.ends_only == 0u || k + 2u == count) state = filterOrderedStep(regions, o, m, fibletToWorld(ds, s.t), state);
     }
   }
-  const bool kept = any && state.y != 0u && state.x == m;
+  const bool kept = state.y != 0u && state.x == m;  // (a fiber without points: the combine drops it)
   FilterHitsRef(pc.hits).hits[fiber].z = kept ? kFilterOrderKept : 0u;
 }

@@ -57,4 +57,16 @@ uvec2 filterOrderedStep(FilterRegionsRef regions, uint first, uint count, vec3 p
   return state;
 }
 
+// Whether the sphere (c, r) reaches the box of any of `count` regions from
+// `first`: when it does not, no point inside the sphere lies in any.
+bool filterSphereNearAny(FilterRegionsRef regions, uint first, uint count, vec3 c, float r) {
+  for (uint i = first; i < first + count; ++i) {
+    const FilterRegion g = regions.regions[i];
+    const vec3 lo = vec3(g.box[0], g.box[1], g.box[2]), hi = vec3(g.box[3], g.box[4], g.box[5]);
+    const vec3 d = max(max(lo - c, c - hi), vec3(0.0));
+    if (dot(d, d) <= r * r) return true;
+  }
+  return false;
+}
+
 #endif

@@ -43,7 +43,7 @@ FILTER_CONST uint kFilterMaxOrderedRegions = 64u;
 FILTER_CONST uint kFilterGroupSize = 64u;  // invocations per workgroup of every filter pass
 
 // One region on the device (std430: the 64-bit member first, then 4-byte
-// scalars only), 96 bytes.
+// scalars only), 128 bytes.
 struct FilterRegion {
   uint64_t mask;  // kFilterMask: uint words, bit (i % 32) of word i / 32 for voxel i = x + nx (y + ny z)
   uint kind;
@@ -53,6 +53,12 @@ struct FilterRegion {
   uint pad0;
   uint pad1;
   float v[16];
+  // A box around the region (world mm; min then max, rounded outward): a
+  // fiblet whose bounding sphere misses every region's box has no vertex
+  // in any, and the hits pass skips decoding it.
+  float box[6];
+  uint pad2;
+  uint pad3;
 };
 
 // Per fiber: x, y = the include / exclude regions one of its vertices lies
@@ -121,7 +127,7 @@ SHADER_FN bool filterOrientedBoxContains(vec3 c, vec3 half_size, vec3 a0, vec3 a
 SHADER_NAMESPACE_END
 
 #ifdef __cplusplus
-static_assert(sizeof(fibscope::shader::FilterRegion) == 96, "a filter region is 96 bytes in std430");
+static_assert(sizeof(fibscope::shader::FilterRegion) == 128, "a filter region is 128 bytes in std430");
 static_assert(offsetof(fibscope::shader::FilterRegion, v) == 32, "the floats follow the header");
 static_assert(sizeof(fibscope::shader::FilterPassPush) == 96, "");
 #endif

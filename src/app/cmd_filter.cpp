@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "app/commands.h"
+#include "app/criteria_options.h"
 #include "app/open_input.h"
 #include "core/error.h"
 #include "core/output_file.h"
@@ -19,24 +20,10 @@ namespace {
 
 struct FilterOptions {
   std::string input, output;
-  std::vector<std::string> include, include_ordered, exclude;
-  bool ends_only = false;
-  double min_length = NAN, max_length = NAN;
+  CriteriaCliOptions criteria;
   bool force = false;
   unsigned threads = 0;
 };
-
-std::vector<Region> regions(const std::vector<std::string>& specs, const char* option) {
-  std::vector<Region> out;
-  for (const std::string& spec : specs) {
-    try {
-      out.push_back(parseRegion(spec));
-    } catch (const Error& e) {
-      throw Error(std::string(option) + " " + e.what());
-    }
-  }
-  return out;
-}
 
 std::string percent(uint64_t part, uint64_t whole) {
   char buf[32];
@@ -45,16 +32,7 @@ std::string percent(uint64_t part, uint64_t whole) {
 }
 
 void runFilterCommand(const FilterOptions& o) {
-  FilterCriteria criteria;
-  criteria.include = regions(o.include, "--include");
-  criteria.include_ordered = regions(o.include_ordered, "--include-ordered");
-  criteria.exclude = regions(o.exclude, "--exclude");
-  criteria.ends_only = o.ends_only;
-  for (const auto& [value, name] : {std::pair{o.min_length, "--min-length"}, std::pair{o.max_length, "--max-length"}})
-    if (!std::isnan(value) && !(value >= 0 && std::isfinite(value)))
-      throw Error(std::string(name) + ": expected a length >= 0 mm");
-  criteria.min_length_mm = o.min_length;
-  criteria.max_length_mm = o.max_length;
+  const FilterCriteria criteria = criteriaFrom(o.criteria);
   // Refuse before reading anything: never overwrite silently.
   checkOverwrite(o.output, o.force);
   const auto start = std::chrono::steady_clock::now();
@@ -80,10 +58,10 @@ void runFilterCommand(const FilterOptions& o) {
     std::printf("  dropped %llu (%s): %s\n", static_cast<unsigned long long>(n), percent(n, r.streamlines).c_str(),
                 what.c_str());
   };
-  if (!std::isnan(o.min_length) || !std::isnan(o.max_length) || r.by_length > 0) dropped("length", r.by_length);
-  for (size_t i = 0; i < r.by_exclude.size(); ++i) dropped("entered --exclude " + o.exclude[i], r.by_exclude[i]);
-  for (size_t i = 0; i < r.by_include.size(); ++i) dropped("missed --include " + o.include[i], r.by_include[i]);
-  if (!o.include_ordered.empty()) dropped("missed the --include-ordered regions or their order", r.by_order);
+  if (!std::isnan(o.criteria.min_length) || !std::isnan(o.criteria.max_length) || r.by_length > 0) dropped("length", r.by_length);
+  for (size_t i = 0; i < r.by_exclude.size(); ++i) dropped("entered --exclude " + o.criteria.exclude[i], r.by_exclude[i]);
+  for (size_t i = 0; i < r.by_include.size(); ++i) dropped("missed --include " + o.criteria.include[i], r.by_include[i]);
+  if (!o.criteria.include_ordered.empty()) dropped("missed the --include-ordered regions or their order", r.by_order);
 }
 
 }  // namespace
@@ -94,15 +72,7 @@ void addFilterCommand(CLI::App& app) {
       "filter", "Keep the streamlines that pass regions of interest and length limits (as MRtrix3's tckedit)");
   cmd->add_option("input", o->input, "Input tractogram (.tck .trk .trx .vtk .fbl)")->required();
   cmd->add_option("output", o->output, "Output tractogram (.tck .trk .trx)")->required();
-  cmd->add_option("--include", o->include,
-                  "A region every kept streamline has a vertex in: sphere:X,Y,Z,R (or X,Y,Z,R), "
-                  "box:X0,Y0,Z0,X1,Y1,Z1 or obox:CX,CY,CZ,SX,SY,SZ,AX,AY,AZ (mm, degrees); repeatable");
-  cmd->add_option("--include-ordered", o->include_ordered,
-                  "Regions a kept streamline enters in the order given (tckedit -include_ordered); repeatable");
-  cmd->add_option("--exclude", o->exclude, "A region no kept streamline has a vertex in; repeatable");
-  cmd->add_flag("--ends-only", o->ends_only, "Test only the two end vertices against the regions");
-  cmd->add_option("--min-length", o->min_length, "Shortest length kept, mm");
-  cmd->add_option("--max-length", o->max_length, "Longest length kept, mm");
+  addCriteriaCliOptions(cmd, o->criteria);
   cmd->add_option("--threads", o->threads, "Threads testing the streamlines (0: every core)");
   cmd->add_flag("--force,-f", o->force, "Overwrite the output if it exists");
   cmd->callback([o] { runFilterCommand(*o); });

@@ -14,6 +14,7 @@
 #include "app/commands.h"
 #include "app/render_options.h"
 #include "app/render_scene.h"
+#include "app/scene_filter.h"
 #include "core/error.h"
 #include "io/png_writer.h"
 #include "render/camera.h"
@@ -63,6 +64,7 @@ void runRender(const RenderCommandOptions& o) {
     throw Error("-o: the output must be a .png file, got '" + o.output + "'");
   if (!o.view.empty() && !o.camera.empty()) throw Error("--view and --camera: give one of them");
   RenderSettings settings = renderSettingsFrom(o.render);
+  const FilterCriteria criteria = criteriaFrom(o.render.criteria);  // bad specs before any work
   uint32_t width = 0, height = 0;
   parseFrameSize(o.render.size, width, height);
 
@@ -95,6 +97,8 @@ void runRender(const RenderCommandOptions& o) {
 
   GpuScene gpu_scene = scene.gpuScene();
   applyScalarColoring(context, scene.fiblets, o.render, settings, gpu_scene);
+  const SceneFilter filter(context, scene, criteria, o.render.dim_dropped);
+  filter.apply(gpu_scene, settings.pipeline);
   const Camera camera = cameraFor(o, scene, width, height);
   auto t = Clock::now();
   FrameRenderer& renderer = *device->renderer;
@@ -109,6 +113,10 @@ void runRender(const RenderCommandOptions& o) {
               static_cast<unsigned long long>(scene.streamlines), static_cast<unsigned long long>(scene.segments),
               o.output.c_str(), width, height, std::string(renderPipelineName(settings.pipeline)).c_str(),
               std::string(cullingModeName(settings.culling)).c_str());
+  if (filter.active())
+    std::printf("filter: %llu of %llu fibers kept (%s), %.2f ms on the GPU\n",
+                static_cast<unsigned long long>(filter.kept()), static_cast<unsigned long long>(filter.fibers()),
+                o.render.dim_dropped ? "the rest dimmed" : "the rest hidden", filter.gpuMilliseconds());
   std::printf("time: read %.3f s, compress %.3f s, upload %.3f s, frame %.3f s (GPU %.1f ms), png %.3f s, total "
               "%.3f s\n",
               scene.read_seconds, scene.encode_seconds, scene.upload_seconds, frame_seconds, stats.gpu_ms,

@@ -45,6 +45,9 @@ void addRenderCliOptions(CLI::App* cmd, RenderCliOptions& o) {
                           settingText(o.defaults, info) + "]");
     }
   }
+  addCriteriaCliOptions(cmd, o.criteria);
+  cmd->add_flag("--dim-dropped", o.dim_dropped,
+                "Draw the fibers the criteria drop dimmed (the kept ones highlighted) instead of hiding them");
   cmd->add_option("--device", o.device, "Vulkan device whose name contains this");
   cmd->add_flag("--validate", o.validate, "Vulkan validation layers on; any message is an error");
 }

@@ -9,6 +9,7 @@
 #include <string>
 #include <string_view>
 
+#include "app/criteria_options.h"
 #include "gpu/vulkan_context.h"
 #include "render/gpu/dataset.h"
 #include "render/gpu/frame_renderer.h"
@@ -34,6 +35,10 @@ struct RenderCliOptions {
   RenderSettings defaults;
   std::map<std::string, std::string, std::less<>> values;
   std::map<std::string, bool, std::less<>> flags;
+  // The fiber filter (app/criteria_options.h; evaluated on the GPU by
+  // app/scene_filter.h): dropped fibers hidden, or dimmed with dim_dropped.
+  CriteriaCliOptions criteria;
+  bool dim_dropped = false;
   // Whether the command line gave the setting `name`.
   bool gave(std::string_view name) const;
 };

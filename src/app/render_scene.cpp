@@ -8,6 +8,7 @@
 #include "io/reader.h"
 #include "phantom/phantom.h"
 #include "render/gpu/tractogram_upload.h"
+#include "select/fiber_filter.h"
 
 namespace fibscope {
 namespace {
@@ -53,6 +54,7 @@ LoadedScene loadScene(const ContextSource& device, const SceneOptions& options) 
     scene.read_seconds = streamed.read_seconds;
     scene.encode_seconds = streamed.upload.encode_seconds;
     scene.upload_seconds = streamed.upload.upload_seconds;
+    scene.step_size_mm = headerStepSize(open()->header());
     return scene;
   }
 
@@ -60,6 +62,7 @@ LoadedScene loadScene(const ContextSource& device, const SceneOptions& options) 
   std::unique_ptr<TractogramReader> reader = open();
   Tractogram points = readAllStreamlines(*reader);
   printWarnings(reader->warnings());
+  scene.step_size_mm = headerStepSize(reader->header());
   if (points.streamlineCount() == 0) throw Error(scene.name + ": no streamlines to render");
   scene.read_seconds = secondsSince(t0);
   scene.bounds = tractogramBounds(points);

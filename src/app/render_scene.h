@@ -4,6 +4,7 @@
 // GPU with the camera box.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -33,6 +34,7 @@ struct LoadedScene {
   Bounds bounds;
   std::vector<Vec3d> sample;  // ~4096 of the points, to frame the view (snugCamera)
   uint64_t streamlines = 0, segments = 0;
+  float step_size_mm = NAN;  // the header's (select/fiber_filter.h: headerStepSize), NaN when it states none
   double read_seconds = 0, encode_seconds = 0, upload_seconds = 0;
 
   // What a frame of this scene draws.

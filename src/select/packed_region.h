@@ -16,6 +16,8 @@ namespace fibscope {
 // Mask regions are packed by the GPU filter itself (their voxels go to a
 // buffer of their own).
 shader::FilterRegion packRegion(const Region& region);
+// Sets r.box to [lo, hi] rounded outward (for regions packed elsewhere).
+void setRegionBox(shader::FilterRegion& r, const std::array<double, 3>& lo, const std::array<double, 3>& hi);
 
 // The float forms of an oriented box (what packRegion stores).
 struct OrientedBoxFloats {

@@ -99,11 +99,67 @@ TEST_F(GpuCliRender, everyPipelineFramesTheSamePictureOfAFile) {
   for (int k = 0; k < 4; ++k) EXPECT_NEAR(double(boxes[0][k]), double(boxes[1][k]), 1.0) << "edge " << k;
 }
 
+// Pixels lit (not the background) in a PNG of ours.
+std::vector<uint8_t> litMask(const test::Png& png) {
+  std::vector<uint8_t> lit(size_t(png.width) * png.height);
+  for (uint32_t y = 0; y < png.height; ++y)
+    for (uint32_t x = 0; x < png.width; ++x) {
+      const uint8_t* p = png.at(x, y);
+      lit[size_t(y) * png.width + x] = (p[0] | p[1] | p[2]) != 0;
+    }
+  return lit;
+}
+
+uint64_t keptCount(const std::string& output, const char* prefix) {
+  const size_t at = output.find(prefix);
+  return at == std::string::npos ? UINT64_MAX : std::stoull(output.substr(at + std::string(prefix).size()));
+}
+
+TEST_F(GpuCliRender, criteriaHideOrDimTheDroppedFibersAndKeepWhatTheFilterCommandKeeps) {
+  const std::string tck = dir_.file("in.tck");
+  ASSERT_EQ(test::runFibscope("phantom " + tck + " -n 400 --seed 4").exit_code, 0);
+  const std::string criteria = " --include box:-60,-60,30,60,60,60 --exclude sphere:0,0,10,12 --min-length 30";
+  const std::string common = "render --validate --size 320x240 --view coronal --no-ssao --background 0,0,0 ";
+  std::vector<std::vector<uint8_t>> lit;
+  std::vector<uint64_t> kept;
+  for (const std::string& extra : std::vector<std::string>{"", criteria, criteria + " --dim-dropped", criteria + " --pipeline raw-compute",
+                                  criteria + " --pipeline lines"}) {
+    SCOPED_TRACE(extra);
+    const std::string png = dir_.file("f" + std::to_string(lit.size()) + ".png");
+    const auto r = runGpuFibscope(common + tck + extra + " -o " + png);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    lit.push_back(litMask(test::readOurPng(png)));
+    kept.push_back(keptCount(r.output, "filter: "));
+  }
+  const auto f = test::runFibscope("filter " + tck + " " + dir_.file("kept.tck") + criteria);
+  ASSERT_EQ(f.exit_code, 0) << f.output;
+  const uint64_t cpu_kept = keptCount(f.output, "kept.tck: ");
+  ASSERT_GT(cpu_kept, 10u);
+  ASSERT_LT(cpu_kept, 390u);
+  // The raw pipelines test the file's own points: the same count as the CPU.
+  EXPECT_EQ(kept[3], cpu_kept);
+  EXPECT_EQ(kept[4], cpu_kept);
+  // The fiblets' decoded points lie within the codec's error of them.
+  EXPECT_NEAR(double(kept[1]), double(cpu_kept), 2.0);
+  size_t all = 0, hidden = 0, outside = 0, dimmed_differ = 0;
+  for (size_t i = 0; i < lit[0].size(); ++i) {
+    all += lit[0][i];
+    hidden += lit[1][i];
+    outside += lit[1][i] && !lit[0][i];
+    dimmed_differ += lit[2][i] != lit[0][i];
+  }
+  EXPECT_LT(hidden, all * 3 / 4) << "hidden: fewer pixels lit";
+  EXPECT_GT(hidden, 0u);
+  EXPECT_EQ(outside, 0u) << "a kept fiber is drawn where the whole tractogram is";
+  EXPECT_EQ(dimmed_differ, 0u) << "dimmed: every fiber still drawn";
+}
+
 TEST_F(GpuCliRender, badOptionsAreOneLineErrors) {
   const std::string png = dir_.file("x.png");
   for (const std::string options :
        {"--size 0x10", "--size 100", "--pipeline fast", "--culling some", "--color red", "--line-width 9",
-        "--background 2,0,0", "--view top", "--camera 1,2", "--view axial --camera 1,2,1"}) {
+        "--background 2,0,0", "--view top", "--camera 1,2", "--view axial --camera 1,2,1",
+        "--include sphere:1,2", "--exclude box:0,0,0,1", "--min-length -3", "--min-length 9 --max-length 2"}) {
     SCOPED_TRACE(options);
     const auto r = runGpuFibscope("render --phantom-streamlines 10 " + options + " -o " + png);
     EXPECT_EQ(r.exit_code, 2) << r.output;

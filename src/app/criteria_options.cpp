@@ -1,0 +1,50 @@
+#include "app/criteria_options.h"
+
+#include <CLI/CLI.hpp>
+
+#include "core/error.h"
+
+namespace fibscope {
+namespace {
+
+std::vector<Region> regions(const std::vector<std::string>& specs, const char* option) {
+  std::vector<Region> out;
+  for (const std::string& spec : specs) {
+    try {
+      out.push_back(parseRegion(spec));
+    } catch (const Error& e) {
+      throw Error(std::string(option) + " " + e.what());
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+void addCriteriaCliOptions(CLI::App* cmd, CriteriaCliOptions& o) {
+  cmd->add_option("--include", o.include,
+                  "A region every kept streamline has a vertex in: sphere:X,Y,Z,R (or X,Y,Z,R), "
+                  "box:X0,Y0,Z0,X1,Y1,Z1 or obox:CX,CY,CZ,SX,SY,SZ,AX,AY,AZ (mm, degrees); repeatable");
+  cmd->add_option("--include-ordered", o.include_ordered,
+                  "Regions a kept streamline enters in the order given (tckedit -include_ordered); repeatable");
+  cmd->add_option("--exclude", o.exclude, "A region no kept streamline has a vertex in; repeatable");
+  cmd->add_flag("--ends-only", o.ends_only, "Test only the two end vertices against the regions");
+  cmd->add_option("--min-length", o.min_length, "Shortest length kept, mm");
+  cmd->add_option("--max-length", o.max_length, "Longest length kept, mm");
+}
+
+FilterCriteria criteriaFrom(const CriteriaCliOptions& o) {
+  FilterCriteria criteria;
+  criteria.include = regions(o.include, "--include");
+  criteria.include_ordered = regions(o.include_ordered, "--include-ordered");
+  criteria.exclude = regions(o.exclude, "--exclude");
+  criteria.ends_only = o.ends_only;
+  for (const auto& [value, name] : {std::pair{o.min_length, "--min-length"}, std::pair{o.max_length, "--max-length"}})
+    if (!std::isnan(value) && !(value >= 0 && std::isfinite(value)))
+      throw Error(std::string(name) + ": expected a length >= 0 mm");
+  criteria.min_length_mm = o.min_length;
+  criteria.max_length_mm = o.max_length;
+  return criteria;
+}
+
+}  // namespace fibscope

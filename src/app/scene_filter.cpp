@@ -1,0 +1,38 @@
+#include "app/scene_filter.h"
+
+namespace fibscope {
+
+SceneFilter::SceneFilter(const gpu::VulkanContext& context, const LoadedScene& scene, const FilterCriteria& criteria,
+                         bool dim)
+    : dim_(dim) {
+  if (criteria.empty()) return;
+  const FiberFilter filter(criteria, scene.step_size_mm);
+  const shader::FibletDataset& block = scene.fiblets.block();
+  const FilterFibletSource source{scene.fiblets.blockAddress(), block.fiblet_count, block.fiber_count, 0,
+                                  scene.fiblets.fiberLength().address};
+  fiblets_ = std::make_unique<GpuFiberFilter>(context);
+  fiblets_->update(filter, std::span(&source, 1), block.fiber_count);
+  gpu_ms_ = fiblets_->lastGpuMilliseconds();
+  if (scene.has_raw) {
+    // The raw vertices are the same fibers in the same order: the
+    // dataset's lengths are theirs.
+    raw_ = std::make_unique<GpuFiberFilter>(context);
+    raw_->update(filter, FilterRawSource{scene.raw.blockAddress(), scene.raw.streamlineCount(), scene.raw.pointCount(),
+                                         scene.fiblets.fiberLength().address});
+  }
+}
+
+void SceneFilter::apply(GpuScene& scene, RenderPipeline pipeline) const {
+  if (!active()) return;
+  const GpuFiberFilter& f = pipeline == RenderPipeline::Compute || !raw_ ? *fiblets_ : *raw_;
+  if (dim_) {
+    // Kept fibers as the selection: the rest dimmed. (Nothing kept: an
+    // empty selection would dim nothing, so the words are passed anyway.)
+    scene.selection_bits = f.keptBits();
+    return;
+  }
+  scene.kept_bits = f.keptBits();
+  scene.kept_point_bits = f.keptPointBits();
+}
+
+}  // namespace fibscope

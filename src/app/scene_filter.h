@@ -1,0 +1,40 @@
+// The fiber filter of what `render` and `bench` draw: the criteria of the
+// command line evaluated on the GPU once (select/gpu/gpu_fiber_filter.h),
+// on the fiblets and, when the baselines' raw vertices are uploaded too,
+// on those, and applied to each frame's GpuScene: dropped fibers hidden
+// (not drawn), or with --dim-dropped drawn dimmed, the kept ones
+// highlighted as a selection.
+#pragma once
+
+#include <memory>
+
+#include "app/render_scene.h"
+#include "render/gpu/scene.h"
+#include "render/render_settings.h"
+#include "select/fiber_filter.h"
+#include "select/gpu/gpu_fiber_filter.h"
+
+namespace fibscope {
+
+class SceneFilter {
+ public:
+  SceneFilter() = default;
+  // Evaluates `criteria` (nothing when empty) with the margin of the
+  // scene's step size. Throws Error as GpuFiberFilter::update does.
+  SceneFilter(const gpu::VulkanContext& context, const LoadedScene& scene, const FilterCriteria& criteria, bool dim);
+
+  bool active() const { return fiblets_ != nullptr; }
+  // Sets what a frame of `pipeline` reads: scene.kept_bits (and
+  // kept_point_bits) when hiding, scene.selection_bits when dimming.
+  void apply(GpuScene& scene, RenderPipeline pipeline) const;
+  uint64_t kept() const { return fiblets_ ? fiblets_->keptCount() : 0; }
+  uint64_t fibers() const { return fiblets_ ? fiblets_->fiberCount() : 0; }
+  double gpuMilliseconds() const { return gpu_ms_; }
+
+ private:
+  std::unique_ptr<GpuFiberFilter> fiblets_, raw_;
+  bool dim_ = false;
+  double gpu_ms_ = 0;
+};
+
+}  // namespace fibscope
