@@ -85,6 +85,17 @@ bool fibletSphere(FibletDataset ds, uint fiblet, out vec3 centre, out float radi
 
 bool sphereOutside(vec4 plane, vec3 c, float r) { return dot(plane.xyz, c) + plane.w < -r * length(plane.xyz); }
 
+// Wholly on the cut side of one of the frame's clip planes (their normals
+// are unit): the raster would clip away every one of its segments. The
+// sphere holds every segment the fiblet draws, so the test is exact up to
+// the rounding the radius's slack absorbs.
+bool sphereClipped(CameraBlock cam, vec3 c, float r) {
+  const uint planes = uint(cam.cuts.x);
+  for (uint i = 0u; i < planes; ++i)
+    if (dot(cam.clip_world[i].xyz, c) + cam.clip_world[i].w < -r) return true;
+  return false;
+}
+
 // The frustum dilated by half the line width plus kCullPixelSlack pixels on
 // each side: a sphere entirely outside it cannot bring a pixel centre within
 // half the line width of its projection. Near and far are not dilated (the
@@ -195,7 +206,9 @@ void main() {
   float r;
   if (fiblet < ds.fiblet_count && fibletKept(ds, fiblet) && fibletSphere(ds, fiblet, c, r)) {
     const CameraBlock cam = CameraRef(pc.camera).camera;
-    if (pc.mode == kCullKeptOnly) {
+    if (sphereClipped(cam, c, r)) {
+      // (culled in every mode: nothing of it would be drawn)
+    } else if (pc.mode == kCullKeptOnly) {
       target = 0;
     } else if (sphereInFrustum(cam, c, r)) {
       bool draw = true;

@@ -16,6 +16,10 @@
 
 layout(push_constant, std430) uniform Push { LinesPush pc; };
 
+// The cuts' clip planes, in world space: the clipper cuts each line where
+// a distance crosses 0 (unused planes pass everything).
+out float gl_ClipDistance[kMaxFrameClipPlanes];
+
 layout(location = 0) flat out uint out_fiber;
 layout(location = 1) flat out uint out_segment;
 layout(location = 2) flat out uint out_tangent;
@@ -31,7 +35,11 @@ void main() {
   const RawChunk c = rawChunk(t, pc.chunk);
   const uint64_t j = first - c.first_point + uint64_t(vertex);
   const vec3 p = rawChunkPoint(c, j);
-  gl_Position = cameraTransformPoint(CameraRef(pc.camera).camera.view_projection, p);
+  const CameraBlock cam = CameraRef(pc.camera).camera;
+  gl_Position = cameraTransformPoint(cam.view_projection, p);
+  const uint planes = uint(cam.cuts.x);
+  for (uint i = 0u; i < kMaxFrameClipPlanes; ++i)
+    gl_ClipDistance[i] = i < planes ? dot(cam.clip_world[i].xyz, p) + cam.clip_world[i].w : 1.0;
   // A streamline the fiber filter dropped: every vertex beyond the far
   // plane, so the clipper removes each of its segments whole.
   if (pc.kept != 0ul && ((UintsRef(pc.kept).values[fiber >> 5u] >> (fiber & 31u)) & 1u) == 0u)

@@ -58,6 +58,19 @@ void rasterPixel(VisibilityRef vis, uint width, int px, int py, vec3 a, vec3 ab,
 // a polyline projects each point once and passes consecutive pairs.
 void rasterClipSegment(VisibilityRef vis, CameraBlock cam, vec4 c0, vec4 c1, uint64_t payload) {
   if (segmentOutsideFrustum(c0, c1)) return;
+  // Step 2b: the cuts' clip planes (CameraBlock::clip_space), each keeping
+  // n.c >= 0: a segment wholly outside one is dropped, one crossing it is
+  // cut where it crosses (the drawn part ends on the plane).
+  const uint planes = uint(cam.cuts.x);
+  for (uint i = 0u; i < planes; ++i) {
+    const vec4 plane = cam.clip_space[i];
+    const float d0 = dot(plane, c0), d1 = dot(plane, c1);
+    if (d0 < 0.0 && d1 < 0.0) return;
+    if (d0 < 0.0 || d1 < 0.0) {
+      const vec4 cut = c0 + (d0 / (d0 - d1)) * (c1 - c0);
+      if (d0 < 0.0) c0 = cut; else c1 = cut;
+    }
+  }
   // Step 3: cut at the near plane z_clip = 0.
   if (c0.z < 0.0 || c1.z < 0.0) {
     const float t = c0.z / (c0.z - c1.z);

@@ -27,12 +27,31 @@
 
 SHADER_NAMESPACE_BEGIN
 
+#ifdef __cplusplus
+#define CAMERA_CONST inline constexpr
+#else
+#define CAMERA_CONST const
+#endif
+
+// Cuts (DESIGN.md section 2): up to kMaxClipPlanes planes of the user's
+// and the slab's two, each keeping the half-space n.p + d >= 0.
+CAMERA_CONST uint kMaxClipPlanes = 6u;
+CAMERA_CONST uint kMaxFrameClipPlanes = 8u;
+
 struct CameraBlock {
   vec4 view_projection[4];  // world mm -> clip, columns
   vec4 view[4];             // world mm -> view (eye at origin, looking down -z), columns
   vec4 eye;                 // xyz: eye position in world mm; w = 1
   vec4 viewport;            // x: width px, y: height px, z: line width px, w: 0
   vec4 depth_range;         // x: near mm, y: far mm (view-space distances); z, w: 0
+  // The frame's clip planes: in world space (n, d) for tests of world
+  // points (the cull, the lines' clip distances), and the same planes in
+  // clip space (transpose(inverse(view_projection)) (n, d), made in double)
+  // for the rasters, which clip segments between clip-space ends: clipping
+  // there is exact clipping in world space, the map being affine.
+  vec4 clip_world[kMaxFrameClipPlanes];
+  vec4 clip_space[kMaxFrameClipPlanes];
+  vec4 cuts;  // x: clip planes in use (a count, 0 .. kMaxFrameClipPlanes); y, z, w: 0
 };
 
 // Column-major 4x4 times (p, 1), summed column by column in a fixed order.
@@ -47,7 +66,7 @@ SHADER_FN vec4 cameraTransformPoint(vec4 m[4], vec3 p) {
 SHADER_NAMESPACE_END
 
 #ifdef __cplusplus
-static_assert(sizeof(fibscope::shader::CameraBlock) == 176, "camera block: 11 vec4, no padding");
+static_assert(sizeof(fibscope::shader::CameraBlock) == 448, "camera block: 28 vec4, no padding");
 #endif
 
 #endif  // FIBSCOPE_SHADERS_SHARED_CAMERA_H

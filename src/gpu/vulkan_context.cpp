@@ -125,6 +125,8 @@ VulkanContext::VulkanContext(const ContextOptions& options) : instance_(options.
   VkPhysicalDeviceFeatures available{};
   vkGetPhysicalDeviceFeatures(info_.handle, &available);
   features.features.wideLines = available.wideLines;
+  // The lines baseline clips at the cuts' planes with gl_ClipDistance.
+  features.features.shaderClipDistance = available.shaderClipDistance;
   features.features.multiDrawIndirect = available.multiDrawIndirect;
   features.features.drawIndirectFirstInstance = available.drawIndirectFirstInstance;
   enabled_ = features.features;

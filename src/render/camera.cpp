@@ -89,7 +89,8 @@ Mat4 viewMatrix(const Camera& camera) { return toFloat(viewMatrixD(camera)); }
 Mat4 projectionMatrix(const Camera& camera) { return toFloat(projectionMatrixD(camera)); }
 Mat4 viewProjection(const Camera& camera) { return toFloat(viewProjectionD(camera)); }
 
-shader::CameraBlock makeCameraBlock(const Camera& camera, float line_width_px) {
+shader::CameraBlock makeCameraBlock(const Camera& camera, float line_width_px,
+                                    const std::vector<std::array<double, 4>>& clip_planes) {
   const Mat4 vp = viewProjection(camera);
   const Mat4 v = viewMatrix(camera);
   shader::CameraBlock block{};
@@ -100,6 +101,18 @@ shader::CameraBlock makeCameraBlock(const Camera& camera, float line_width_px) {
   block.eye = {float(camera.eye[0]), float(camera.eye[1]), float(camera.eye[2]), 1.0f};
   block.viewport = {float(camera.width), float(camera.height), line_width_px, 0.0f};
   block.depth_range = {float(camera.near_mm), float(camera.far_mm), 0.0f, 0.0f};
+  if (clip_planes.size() > shader::kMaxFrameClipPlanes)
+    throw Error("camera: at most " + std::to_string(shader::kMaxFrameClipPlanes) + " clip planes");
+  // A plane L keeps points P (homogeneous) with L.P >= 0; clip = M P, so
+  // in clip space it is L.M^-1 c = (M^-T L).c >= 0.
+  const glm::dmat4 inverse_transpose = glm::transpose(glm::inverse(toGlm(viewProjectionD(camera))));
+  for (size_t i = 0; i < clip_planes.size(); ++i) {
+    const auto& q = clip_planes[i];
+    const glm::dvec4 c = inverse_transpose * glm::dvec4(q[0], q[1], q[2], q[3]);
+    block.clip_world[i] = {float(q[0]), float(q[1]), float(q[2]), float(q[3])};
+    block.clip_space[i] = {float(c.x), float(c.y), float(c.z), float(c.w)};
+  }
+  block.cuts = {float(clip_planes.size()), 0.0f, 0.0f, 0.0f};
   return block;
 }
 

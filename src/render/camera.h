@@ -56,7 +56,10 @@ std::array<double, 16> projectionMatrixD(const Camera& camera);
 std::array<double, 16> viewProjectionD(const Camera& camera);
 
 // The shader-side block (shaders/shared/camera.h) for this camera.
-shader::CameraBlock makeCameraBlock(const Camera& camera, float line_width_px);
+// `clip_planes`: world (n, d) planes (render/clip_planes.h), at most
+// shader::kMaxFrameClipPlanes; the block gets them and their clip-space form.
+shader::CameraBlock makeCameraBlock(const Camera& camera, float line_width_px,
+                                    const std::vector<std::array<double, 4>>& clip_planes = {});
 
 // Axis-aligned box in world mm; empty when min > max.
 struct Bounds {

@@ -77,11 +77,29 @@ namespace {
 
 using Clip = std::array<double, 4>;
 
-Clip toClip(const std::array<double, 16>& m, const float* p) {
+Clip toClip(const std::array<double, 16>& m, const double* p) {
   Clip c{};
-  for (int r = 0; r < 4; ++r)
-    c[r] = m[r] * double(p[0]) + m[4 + r] * double(p[1]) + m[8 + r] * double(p[2]) + m[12 + r];
+  for (int r = 0; r < 4; ++r) c[r] = m[r] * p[0] + m[4 + r] * p[1] + m[8 + r] * p[2] + m[12 + r];
   return c;
+}
+
+// Step 2b: the part of world segment a -> b on the kept side of every
+// plane (n.p + d >= 0), cut where it crosses one, in world space; false
+// when nothing is left.
+bool clipToPlanes(std::array<double, 3>& a, std::array<double, 3>& b,
+                  const std::vector<std::array<double, 4>>& planes) {
+  for (const auto& q : planes) {
+    const double da = q[0] * a[0] + q[1] * a[1] + q[2] * a[2] + q[3];
+    const double db = q[0] * b[0] + q[1] * b[1] + q[2] * b[2] + q[3];
+    if (da < 0 && db < 0) return false;
+    if (da < 0 || db < 0) {
+      const double t = da / (da - db);
+      std::array<double, 3> cut{};
+      for (int k = 0; k < 3; ++k) cut[k] = a[k] + t * (b[k] - a[k]);
+      (da < 0 ? a : b) = cut;
+    }
+  }
+  return true;
 }
 
 // Step 2: both ends outside the same plane of the frustum.
@@ -100,7 +118,8 @@ WindowVertex toWindow(const Clip& c, uint32_t width, uint32_t height) {
 
 }  // namespace
 
-ReferenceFrame rasterizeReference(const Tractogram& tractogram, const Camera& camera, float line_width_px) {
+ReferenceFrame rasterizeReference(const Tractogram& tractogram, const Camera& camera, float line_width_px,
+                                  const std::vector<std::array<double, 4>>& clip_planes) {
   if (!(line_width_px >= kMinLineWidth && line_width_px <= kMaxLineWidth))
     fail("reference raster", "line width must lie in [1, 4] px, got " + std::to_string(line_width_px));
   if (tractogram.streamlineCount() >= kNoFiber)
@@ -113,7 +132,9 @@ ReferenceFrame rasterizeReference(const Tractogram& tractogram, const Camera& ca
     for (size_t j = 0; j + 1 < n; ++j) {
       const float* p0 = tractogram.point(first + j);
       const float* p1 = tractogram.point(first + j + 1);
-      Clip c0 = toClip(vp, p0), c1 = toClip(vp, p1);
+      std::array<double, 3> w0 = {p0[0], p0[1], p0[2]}, w1 = {p1[0], p1[1], p1[2]};
+      if (!clipToPlanes(w0, w1, clip_planes)) continue;
+      Clip c0 = toClip(vp, w0.data()), c1 = toClip(vp, w1.data());
       if (outsideFrustum(c0, c1)) continue;
       // Step 3: near plane z >= 0; the part behind it is cut off.
       if (c0[2] < 0 || c1[2] < 0) {

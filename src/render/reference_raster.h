@@ -82,8 +82,13 @@ void rasterizeWindowSegment(ReferenceFrame& frame, const WindowVertex& a, const 
 // Draws every segment of `tractogram` (steps 1-7). Throws Error for an
 // invalid camera, a line width outside [kMinLineWidth, kMaxLineWidth], or
 // more than 2^32 - 1 streamlines or points per streamline.
+// With `clip_planes` (world (n, d), each keeping n.p + d >= 0), each
+// segment is first cut to the kept side of every plane in world space
+// (step 2b: the part left is drawn, its clipped ends on the planes; the
+// tangent stays the whole segment's).
 ReferenceFrame rasterizeReference(const Tractogram& tractogram, const Camera& camera,
-                                  float line_width_px = 1.0f);
+                                  float line_width_px = 1.0f,
+                                  const std::vector<std::array<double, 4>>& clip_planes = {});
 
 // A sphere drawn with the lines: the CPU reference of the surface passes
 // (shaders/sphere_surface.comp and the merge, shared/surface_push.h).

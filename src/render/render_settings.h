@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -97,6 +98,17 @@ struct RenderSettings {
   // the shaded RGBA8 image: smooths the stair steps of 1-pixel lines.
   bool fxaa = false;
   std::array<float, 3> background = {0.0f, 0.0f, 0.0f};
+  // Cuts (DESIGN.md section 2): fibers are clipped per pixel, not dropped,
+  // and a segment crossing a plane is drawn up to the plane
+  // (render/clip_planes.h). clip_planes: world (n, d), each keeping
+  // n.p + d >= 0; at most shader::kMaxClipPlanes.
+  std::vector<std::array<double, 4>> clip_planes;
+  // mrview's slab: only what lies within slab_mm / 2 of a plane is drawn
+  // (0: no slab). The plane is slab_plane (n, d) when set, e.g. an
+  // anatomical slice's, else the focal plane: through the camera's target,
+  // facing the viewer, so the slab moves with the view.
+  float slab_mm = 0.0f;
+  std::optional<std::array<double, 4>> slab_plane;
 };
 
 // Parsing and names for the command line ("compute", "two-phase", ...).

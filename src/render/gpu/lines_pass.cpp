@@ -22,6 +22,9 @@ LinesPass createLinesPass(const gpu::VulkanContext& context) {
   if (!context.info().queue_has_graphics)
     throw Error("render: the lines pipeline needs a graphics queue, " + context.info().name +
                 " has none (use the compute or raw-compute pipeline)");
+  if (!context.enabledFeatures().shaderClipDistance)
+    throw Error("render: the lines pipeline clips with gl_ClipDistance, which " + context.info().name +
+                " lacks (use the compute or raw-compute pipeline)");
   gpu::GraphicsPipelineDesc desc;
   desc.vertex_shader = "lines.vert";
   desc.fragment_shader = "lines.frag";

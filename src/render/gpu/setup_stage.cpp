@@ -6,6 +6,7 @@
 
 #include "gpu/buffer.h"
 #include "gpu/pass_scope.h"
+#include "render/clip_planes.h"
 #include "render/gpu/frame_stages.h"
 
 namespace fibscope {
@@ -26,7 +27,8 @@ class SetupStage final : public FrameStage {
                                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT,
                                  gpu::kStorageReadWrite};
     gpu::PassScope pass(frame.cmd, frame.timer, "clear", after);
-    const shader::CameraBlock block = makeCameraBlock(frame.camera, frame.settings.line_width_px);
+    const shader::CameraBlock block =
+        makeCameraBlock(frame.camera, frame.settings.line_width_px, frameClipPlanes(frame.settings, frame.camera));
     vkCmdUpdateBuffer(frame.cmd, frame.targets.camera.buffer, 0, sizeof(block), &block);
     if (frame.settings.pipeline == RenderPipeline::Compute) {
       const std::vector<uint32_t> words = sceneTableWords(frame.layout);
