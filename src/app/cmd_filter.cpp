@@ -13,6 +13,7 @@
 #include "core/progress.h"
 #include "io/writer.h"
 #include "select/filter_run.h"
+#include "select/roi_set.h"
 
 namespace fibscope {
 namespace {
@@ -20,6 +21,7 @@ namespace {
 struct FilterOptions {
   std::string input, output;
   std::vector<std::string> include, include_ordered, exclude;
+  std::string roi_set;
   bool ends_only = false;
   double min_length = NAN, max_length = NAN;
   bool force = false;
@@ -55,6 +57,20 @@ void runFilterCommand(const FilterOptions& o) {
       throw Error(std::string(name) + ": expected a length >= 0 mm");
   criteria.min_length_mm = o.min_length;
   criteria.max_length_mm = o.max_length;
+  // A set's regions come first, the command line's after them: the report
+  // names them in that order.
+  std::vector<std::string> include_names, exclude_names;
+  if (!o.roi_set.empty()) {
+    const RoiSet set = loadRoiSet(o.roi_set);
+    criteria = mergeCriteria(filterCriteria(set), criteria);
+    for (const Roi& roi : set.rois) {
+      const std::string name = "ROI '" + roi.name + "' (" + regionSpec(roi.region) + ") of " + o.roi_set;
+      if (roi.enabled && roi.role == RoiRole::Include) include_names.push_back("--roi-set include " + name);
+      if (roi.enabled && roi.role == RoiRole::Exclude) exclude_names.push_back("--roi-set exclude " + name);
+    }
+  }
+  for (const std::string& spec : o.include) include_names.push_back("--include " + spec);
+  for (const std::string& spec : o.exclude) exclude_names.push_back("--exclude " + spec);
   // Refuse before reading anything: never overwrite silently.
   checkOverwrite(o.output, o.force);
   const auto start = std::chrono::steady_clock::now();
@@ -80,10 +96,11 @@ void runFilterCommand(const FilterOptions& o) {
     std::printf("  dropped %llu (%s): %s\n", static_cast<unsigned long long>(n), percent(n, r.streamlines).c_str(),
                 what.c_str());
   };
-  if (!std::isnan(o.min_length) || !std::isnan(o.max_length) || r.by_length > 0) dropped("length", r.by_length);
-  for (size_t i = 0; i < r.by_exclude.size(); ++i) dropped("entered --exclude " + o.exclude[i], r.by_exclude[i]);
-  for (size_t i = 0; i < r.by_include.size(); ++i) dropped("missed --include " + o.include[i], r.by_include[i]);
-  if (!o.include_ordered.empty()) dropped("missed the --include-ordered regions or their order", r.by_order);
+  if (!std::isnan(criteria.min_length_mm) || !std::isnan(criteria.max_length_mm) || r.by_length > 0)
+    dropped("length", r.by_length);
+  for (size_t i = 0; i < r.by_exclude.size(); ++i) dropped("entered " + exclude_names[i], r.by_exclude[i]);
+  for (size_t i = 0; i < r.by_include.size(); ++i) dropped("missed " + include_names[i], r.by_include[i]);
+  if (!criteria.include_ordered.empty()) dropped("missed the --include-ordered regions or their order", r.by_order);
 }
 
 }  // namespace
@@ -100,6 +117,10 @@ void addFilterCommand(CLI::App& app) {
   cmd->add_option("--include-ordered", o->include_ordered,
                   "Regions a kept streamline enters in the order given (tckedit -include_ordered); repeatable");
   cmd->add_option("--exclude", o->exclude, "A region no kept streamline has a vertex in; repeatable");
+  cmd->add_option("--roi-set", o->roi_set,
+                  "A ROI set (JSON, as the viewer saves it): its enabled regions, ends-only flag and length limits "
+                  "join the options here (whose regions come after its; whose length limits win); its cuts and "
+                  "anatomy are for the viewer");
   cmd->add_flag("--ends-only", o->ends_only, "Test only the two end vertices against the regions");
   cmd->add_option("--min-length", o->min_length, "Shortest length kept, mm");
   cmd->add_option("--max-length", o->max_length, "Longest length kept, mm");
