@@ -124,7 +124,7 @@ std::string oneLine(std::string s) {
   return s;
 }
 
-double cross2(glm::dvec2 a, glm::dvec2 b) { return a.x * b.y - a.y * b.x; }
+double cross2(const glm::dvec2& a, const glm::dvec2& b) { return a.x * b.y - a.y * b.x; }
 
 // Appends the triangles of one face (vertex indices in the file's order).
 // A polygon is ear-clipped in the plane of its Newell normal, so a concave

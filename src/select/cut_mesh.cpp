@@ -19,7 +19,7 @@ glm::dvec3 toVec(const std::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
 
 // A box from its centre and three half-extent vectors: one quad per side,
 // each wound so that its normal points away from the centre.
-TriangleMesh boxMesh(glm::dvec3 centre, const glm::dvec3 (&half)[3]) {
+TriangleMesh boxMesh(const glm::dvec3& centre, const glm::dvec3 (&half)[3]) {
   TriangleMesh mesh;
   for (int corner = 0; corner < 8; ++corner) {  // bit k: + or - along axis k
     glm::dvec3 p = centre;
@@ -44,7 +44,7 @@ TriangleMesh boxMesh(glm::dvec3 centre, const glm::dvec3 (&half)[3]) {
 // and Strackee 1983), signed: > 0 when its normal cross(b - a, c - a)
 // points away from the origin (a . (b x c) is a . that normal), as the
 // triangles of an outward mesh do seen from inside.
-double solidAngle(glm::dvec3 a, glm::dvec3 b, glm::dvec3 c) {
+double solidAngle(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
   const double la = glm::length(a), lb = glm::length(b), lc = glm::length(c);
   const double num = glm::dot(a, glm::cross(b, c));
   const double den = la * lb * lc + glm::dot(a, b) * lc + glm::dot(a, c) * lb + glm::dot(b, c) * la;
@@ -67,7 +67,7 @@ TriangleMesh makeBoxMesh(const OrientedBoxRegion& box) {
   return boxMesh(toVec(box.center), half);
 }
 
-TriangleMesh makeSphereMesh(glm::vec3 centre, float radius, int subdivisions) {
+TriangleMesh makeSphereMesh(const glm::vec3& centre, float radius, int subdivisions) {
   assert(subdivisions >= 0 && subdivisions <= kMaxSphereSubdivisions && radius > 0);
   // The icosahedron: the cyclic permutations of (0, +-1, +-phi).
   const double phi = (1 + std::sqrt(5.0)) / 2;
@@ -185,7 +185,7 @@ bool orientOutward(TriangleMesh& mesh) {
   return true;
 }
 
-double windingNumber(const TriangleMesh& mesh, glm::vec3 p) {
+double windingNumber(const TriangleMesh& mesh, const glm::vec3& p) {
   const glm::dvec3 o = p;
   double sum = 0;
   for (const glm::uvec3& t : mesh.triangles)
@@ -194,9 +194,9 @@ double windingNumber(const TriangleMesh& mesh, glm::vec3 p) {
   return sum / (4 * glm::pi<double>());
 }
 
-bool pointInsideMesh(const TriangleMesh& mesh, glm::vec3 p) { return std::fabs(windingNumber(mesh, p)) >= 0.5; }
+bool pointInsideMesh(const TriangleMesh& mesh, const glm::vec3& p) { return std::fabs(windingNumber(mesh, p)) >= 0.5; }
 
-std::vector<MeshHit> rayMeshHits(const TriangleMesh& mesh, glm::vec3 origin, glm::vec3 dir) {
+std::vector<MeshHit> rayMeshHits(const TriangleMesh& mesh, const glm::vec3& origin, const glm::vec3& dir) {
   std::vector<MeshHit> hits;
   const glm::dvec3 o = origin, d0 = dir;
   if (!(glm::length(d0) > 0)) return hits;

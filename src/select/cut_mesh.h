@@ -32,7 +32,7 @@ TriangleMesh makeBoxMesh(const OrientedBoxRegion& box);
 // is inside it. Outward, closed.
 inline constexpr int kMaxSphereSubdivisions = 7;
 inline constexpr int kCutSphereSubdivisions = 4;  // the sphere: cut: 5,120 triangles, r (1 - cos theta) < 0.12 % of r
-TriangleMesh makeSphereMesh(glm::vec3 centre, float radius, int subdivisions);
+TriangleMesh makeSphereMesh(const glm::vec3& centre, float radius, int subdivisions);
 // An upper bound (radians) on the angle, seen from the centre, between a
 // face's nearest point and its vertices: for s = 0 the icosahedron's own,
 // 37.38 degrees (cos = phi^2 / (sqrt 3 sqrt(phi^2 + 1)), its inradius over its
@@ -68,14 +68,14 @@ bool orientOutward(TriangleMesh& mesh);
 // the sum of the triangles' signed solid angles / 4 pi, van Oosterom and
 // Strackee's formula, in double): 1 inside an outward closed mesh, 0
 // outside, -1 inside an inward one, fractional near holes.
-double windingNumber(const TriangleMesh& mesh, glm::vec3 p);
+double windingNumber(const TriangleMesh& mesh, const glm::vec3& p);
 // Whether p lies inside: |winding number| >= 0.5. Chosen over ray parity
 // because it needs no ray direction (no ray grazing an edge or a vertex
 // counted twice or not at all), works for either global orientation,
 // takes the union where closed objects overlap (parity would punch holes),
 // and degrades gradually, not along a random ray, where the mesh has a hole
 // (closureWarning). Undefined on the surface itself. O(triangles).
-bool pointInsideMesh(const TriangleMesh& mesh, glm::vec3 p);
+bool pointInsideMesh(const TriangleMesh& mesh, const glm::vec3& p);
 
 // Where the ray origin + t * dir (t >= 0) meets the mesh: the distances t
 // in mm along normalize(dir), ascending, each with its facing: front when
@@ -89,7 +89,7 @@ struct MeshHit {
   float distance = 0;
   bool front = false;
 };
-std::vector<MeshHit> rayMeshHits(const TriangleMesh& mesh, glm::vec3 origin, glm::vec3 dir);
+std::vector<MeshHit> rayMeshHits(const TriangleMesh& mesh, const glm::vec3& origin, const glm::vec3& dir);
 
 // The mesh a --cut-mesh SPEC (without its :inside / :outside) names:
 //   box:X0,Y0,Z0,X1,Y1,Z1, obox:CX,...,AZ, sphere:X,Y,Z,R   built in, with

@@ -36,9 +36,9 @@ std::string number(float v) {
 
 }  // namespace
 
-bool planeKeeps(const ClipPlane& plane, glm::vec3 p) { return glm::dot(p - plane.point, plane.normal) >= 0; }
+bool planeKeeps(const ClipPlane& plane, const glm::vec3& p) { return glm::dot(p - plane.point, plane.normal) >= 0; }
 
-ClipPlane makeClipPlane(glm::vec3 point, glm::vec3 normal, const std::string& where) {
+ClipPlane makeClipPlane(const glm::vec3& point, const glm::vec3& normal, const std::string& where) {
   const glm::dvec3 n = normal;
   const double length = glm::length(n);
   if (!(std::isfinite(length) && length > 0)) fail(where, "a clip plane's normal must be non-zero and finite");
@@ -107,7 +107,8 @@ std::string clipPlaneSpec(const ClipPlane& p) {
 
 std::string meshCutSpec(const MeshCut& cut) { return cut.spec + (cut.cull_inside ? ":inside" : ":outside"); }
 
-std::optional<std::pair<float, float>> clipSegment(glm::vec3 a, glm::vec3 b, const std::vector<ClipPlane>& planes) {
+std::optional<std::pair<float, float>> clipSegment(const glm::vec3& a, const glm::vec3& b,
+                                                   const std::vector<ClipPlane>& planes) {
   double t0 = 0, t1 = 1;
   for (const ClipPlane& plane : planes) {
     const glm::dvec3 n = plane.normal, q = plane.point;

@@ -29,7 +29,7 @@ struct ClipPlane {
 };
 inline constexpr size_t kMaxClipPlanes = 6;  // active at once (the GPU cull's slots)
 
-bool planeKeeps(const ClipPlane& plane, glm::vec3 p);
+bool planeKeeps(const ClipPlane& plane, const glm::vec3& p);
 
 // A slab keeps what lies within thickness_mm / 2 of its plane; which plane
 // (the view's focal plane, or the anatomy slice it follows) the renderer
@@ -62,7 +62,7 @@ struct CutSet {
 ClipPlane parseClipPlane(std::string_view spec);
 // A plane from raw values: the normal is normalised; Error "WHERE: ..."
 // for a zero or non-finite one.
-ClipPlane makeClipPlane(glm::vec3 point, glm::vec3 normal, const std::string& where);
+ClipPlane makeClipPlane(const glm::vec3& point, const glm::vec3& normal, const std::string& where);
 Slab parseSlab(std::string_view spec);
 bool isSlabFollow(std::string_view follow);
 MeshCut parseMeshCut(std::string_view spec);
@@ -76,6 +76,7 @@ std::string meshCutSpec(const MeshCut& cut);
 // - d_b) where the signed distances d change sign); a segment lying in a
 // plane is kept (boundaries are kept), and t0 == t1 where only one point
 // is. No planes: the whole segment.
-std::optional<std::pair<float, float>> clipSegment(glm::vec3 a, glm::vec3 b, const std::vector<ClipPlane>& planes);
+std::optional<std::pair<float, float>> clipSegment(const glm::vec3& a, const glm::vec3& b,
+                                                   const std::vector<ClipPlane>& planes);
 
 }  // namespace fibscope

@@ -52,9 +52,11 @@ class SetReader {
   // An object whose keys are all among `allowed`.
   void checkKeys(const json& v, const std::string& place, std::initializer_list<const char*> allowed) const {
     if (!v.is_object()) failAt(place, std::string("expected an object, found ") + typeName(v));
-    for (const auto& [key, value] : v.items())
+    for (const auto& item : v.items()) {
+      const std::string& key = item.key();
       if (std::none_of(allowed.begin(), allowed.end(), [&](const char* k) { return key == k; }))
         failAt(place, "unknown key \"" + key + "\"");
+    }
   }
   const json* find(const json& object, const char* key) const {
     const auto it = object.find(key);
@@ -208,7 +210,7 @@ json floatValue(float v) {
   return d;
 }
 
-json vec3Value(glm::vec3 v) { return json::array({floatValue(v.x), floatValue(v.y), floatValue(v.z)}); }
+json vec3Value(const glm::vec3& v) { return json::array({floatValue(v.x), floatValue(v.y), floatValue(v.z)}); }
 
 }  // namespace
 
