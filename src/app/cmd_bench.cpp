@@ -94,7 +94,7 @@ void runBench(const BenchOptions& o) {
   if (o.frames < 1 || o.frames > 100000) throw Error("--frames: expected 1 to 100000");
   if (!(std::fabs(o.step_deg) <= 360)) throw Error("--step: expected degrees in [-360, 360]");
   std::vector<Variant> variants = variantsFrom(o);
-  const FilterCriteria criteria = criteriaFrom(o.render.criteria);  // bad specs before any work
+  const FilterCriteria criteria = criteriaFrom(o.render.criteria).criteria;  // bad specs before any work
   uint32_t width = 0, height = 0;
   parseFrameSize(o.render.size, width, height);
   bool need_points = false;

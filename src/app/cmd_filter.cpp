@@ -32,7 +32,8 @@ std::string percent(uint64_t part, uint64_t whole) {
 }
 
 void runFilterCommand(const FilterOptions& o) {
-  const FilterCriteria criteria = criteriaFrom(o.criteria);
+  const CliCriteria named = criteriaFrom(o.criteria);
+  const FilterCriteria& criteria = named.criteria;
   // Refuse before reading anything: never overwrite silently.
   checkOverwrite(o.output, o.force);
   const auto start = std::chrono::steady_clock::now();
@@ -58,10 +59,11 @@ void runFilterCommand(const FilterOptions& o) {
     std::printf("  dropped %llu (%s): %s\n", static_cast<unsigned long long>(n), percent(n, r.streamlines).c_str(),
                 what.c_str());
   };
-  if (!std::isnan(o.criteria.min_length) || !std::isnan(o.criteria.max_length) || r.by_length > 0) dropped("length", r.by_length);
-  for (size_t i = 0; i < r.by_exclude.size(); ++i) dropped("entered --exclude " + o.criteria.exclude[i], r.by_exclude[i]);
-  for (size_t i = 0; i < r.by_include.size(); ++i) dropped("missed --include " + o.criteria.include[i], r.by_include[i]);
-  if (!o.criteria.include_ordered.empty()) dropped("missed the --include-ordered regions or their order", r.by_order);
+  if (!std::isnan(criteria.min_length_mm) || !std::isnan(criteria.max_length_mm) || r.by_length > 0)
+    dropped("length", r.by_length);
+  for (size_t i = 0; i < r.by_exclude.size(); ++i) dropped("entered " + named.exclude_names[i], r.by_exclude[i]);
+  for (size_t i = 0; i < r.by_include.size(); ++i) dropped("missed " + named.include_names[i], r.by_include[i]);
+  if (!criteria.include_ordered.empty()) dropped("missed the --include-ordered regions or their order", r.by_order);
 }
 
 }  // namespace

@@ -64,7 +64,7 @@ void runRender(const RenderCommandOptions& o) {
     throw Error("-o: the output must be a .png file, got '" + o.output + "'");
   if (!o.view.empty() && !o.camera.empty()) throw Error("--view and --camera: give one of them");
   RenderSettings settings = renderSettingsFrom(o.render);
-  const FilterCriteria criteria = criteriaFrom(o.render.criteria);  // bad specs before any work
+  const FilterCriteria criteria = criteriaFrom(o.render.criteria).criteria;  // bad specs before any work
   uint32_t width = 0, height = 0;
   parseFrameSize(o.render.size, width, height);
 

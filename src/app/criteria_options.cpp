@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 
 #include "core/error.h"
+#include "select/roi_set.h"
 
 namespace fibscope {
 namespace {
@@ -31,10 +32,14 @@ void addCriteriaCliOptions(CLI::App* cmd, CriteriaCliOptions& o) {
   cmd->add_flag("--ends-only", o.ends_only, "Test only the two end vertices against the regions");
   cmd->add_option("--min-length", o.min_length, "Shortest length kept, mm");
   cmd->add_option("--max-length", o.max_length, "Longest length kept, mm");
+  cmd->add_option("--roi-set", o.roi_set,
+                  "A ROI set (JSON, as the viewer saves it): its enabled regions, ends-only flag and length limits "
+                  "join the options here (whose regions come after its; whose length limits win)");
 }
 
-FilterCriteria criteriaFrom(const CriteriaCliOptions& o) {
-  FilterCriteria criteria;
+CliCriteria criteriaFrom(const CriteriaCliOptions& o) {
+  CliCriteria out;
+  FilterCriteria& criteria = out.criteria;
   criteria.include = regions(o.include, "--include");
   criteria.include_ordered = regions(o.include_ordered, "--include-ordered");
   criteria.exclude = regions(o.exclude, "--exclude");
@@ -44,7 +49,18 @@ FilterCriteria criteriaFrom(const CriteriaCliOptions& o) {
       throw Error(std::string(name) + ": expected a length >= 0 mm");
   criteria.min_length_mm = o.min_length;
   criteria.max_length_mm = o.max_length;
-  return criteria;
+  if (!o.roi_set.empty()) {
+    const RoiSet set = loadRoiSet(o.roi_set);
+    criteria = mergeCriteria(filterCriteria(set), criteria);
+    for (const Roi& roi : set.rois) {
+      const std::string name = "ROI '" + roi.name + "' (" + regionSpec(roi.region) + ") of " + o.roi_set;
+      if (roi.enabled && roi.role == RoiRole::Include) out.include_names.push_back("--roi-set include " + name);
+      if (roi.enabled && roi.role == RoiRole::Exclude) out.exclude_names.push_back("--roi-set exclude " + name);
+    }
+  }
+  for (const std::string& spec : o.include) out.include_names.push_back("--include " + spec);
+  for (const std::string& spec : o.exclude) out.exclude_names.push_back("--exclude " + spec);
+  return out;
 }
 
 }  // namespace fibscope

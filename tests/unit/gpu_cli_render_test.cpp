@@ -125,7 +125,9 @@ TEST_F(GpuCliRender, criteriaHideOrDimTheDroppedFibersAndKeepWhatTheFilterComman
   for (const std::string& extra : std::vector<std::string>{"", criteria, criteria + " --dim-dropped", criteria + " --pipeline raw-compute",
                                   criteria + " --pipeline lines"}) {
     SCOPED_TRACE(extra);
-    const std::string png = dir_.file("f" + std::to_string(lit.size()) + ".png");
+    std::string name = std::to_string(lit.size());
+    name += ".png";
+    const std::string png = dir_.file(name);
     const auto r = runGpuFibscope(common + tck + extra + " -o " + png);
     ASSERT_EQ(r.exit_code, 0) << r.output;
     lit.push_back(litMask(test::readOurPng(png)));
