@@ -7,7 +7,10 @@
 #include <vector>
 
 #include "core/error.h"
+#include "render/clip_planes.h"
 #include "render/colormap.h"
+#include "select/cuts.h"
+#include "select/roi_set.h"
 #include "render/settings_table.h"
 
 namespace fibscope {
@@ -46,6 +49,9 @@ void addRenderCliOptions(CLI::App* cmd, RenderCliOptions& o) {
     }
   }
   addCriteriaCliOptions(cmd, o.criteria);
+  cmd->add_option("--clip-plane", o.clip_planes,
+                  "Draw only the side of the plane through PX,PY,PZ that the normal NX,NY,NZ points to (mm); "
+                  "fibers are clipped at the plane; repeatable, at most 6");
   cmd->add_flag("--dim-dropped", o.dim_dropped,
                 "Draw the fibers the criteria drop dimmed (the kept ones highlighted) instead of hiding them");
   cmd->add_option("--device", o.device, "Vulkan device whose name contains this");
@@ -74,6 +80,26 @@ RenderSettings renderSettingsFrom(const RenderCliOptions& o) {
     const auto v = o.values.find(name);
     if (v != o.values.end() && !v->second.empty()) setSetting(s, info, v->second, "--" + name);
   }
+  auto addPlane = [&](const ClipPlane& p) {
+    s.clip_planes.push_back(planeThrough({p.point.x, p.point.y, p.point.z}, {p.normal.x, p.normal.y, p.normal.z}));
+  };
+  if (!o.criteria.roi_set.empty()) {
+    // The set's cuts; the command line's planes come after them and its
+    // --slab wins.
+    const CutSet cuts = cutSet(loadRoiSet(o.criteria.roi_set));
+    for (const ClipPlane& p : cuts.planes) addPlane(p);
+    if (cuts.slab && !o.gave("slab")) s.slab_mm = cuts.slab->thickness_mm;
+  }
+  for (const std::string& spec : o.clip_planes) {
+    try {
+      addPlane(parseClipPlane(spec));
+    } catch (const Error& e) {
+      throw Error(std::string("--clip-plane ") + e.what());
+    }
+  }
+  if (s.clip_planes.size() > shader::kMaxClipPlanes)
+    throw Error("--clip-plane: at most " + std::to_string(shader::kMaxClipPlanes) + " planes, got " +
+                std::to_string(s.clip_planes.size()));
   return s;
 }
 

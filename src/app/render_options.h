@@ -8,6 +8,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "app/criteria_options.h"
 #include "gpu/vulkan_context.h"
@@ -39,6 +40,9 @@ struct RenderCliOptions {
   // app/scene_filter.h): dropped fibers hidden, or dimmed with dim_dropped.
   CriteriaCliOptions criteria;
   bool dim_dropped = false;
+  // Cuts: --clip-plane PX,PY,PZ,NX,NY,NZ (repeatable; select/cuts.h), and
+  // the planes and slab of --roi-set's set; --slab is a setting.
+  std::vector<std::string> clip_planes;
   // Whether the command line gave the setting `name`.
   bool gave(std::string_view name) const;
 };
@@ -47,8 +51,9 @@ struct RenderCliOptions {
 // (its help and default from the table and `options.defaults`).
 void addRenderCliOptions(CLI::App* cmd, RenderCliOptions& options);
 
-// The settings the options name. Throws Error (one line) naming the option
-// and what it expects (render/settings_table.h: setSetting).
+// The settings the options name, with the cuts (the ROI set read). Throws
+// Error (one line) naming the option or file and what it expects
+// (render/settings_table.h: setSetting).
 RenderSettings renderSettingsFrom(const RenderCliOptions& options);
 void parseFrameSize(const std::string& text, uint32_t& width, uint32_t& height);
 

@@ -158,6 +158,9 @@ std::vector<SettingInfo> makeTable() {
                    hasSsao));
   t.push_back(flag("fxaa", "FXAA", "Fast approximate anti-aliasing of the image", &RenderSettings::fxaa));
   t.push_back(color("background", "background", "Background colour R,G,B in [0, 1]", &RenderSettings::background));
+  t.push_back(number("slab", "slab",
+                     "Draw only a slab this thick around the focal plane (moving with the view), mm; 0: off",
+                     &RenderSettings::slab_mm, 0, 1000, "mm"));
   return t;
 }
 
