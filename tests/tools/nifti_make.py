@@ -6,12 +6,20 @@
                                  the file, nibabel's img.affine, the shape,
                                  the volume count and the first volume's
                                  values (x fastest)
+  nifti_make.py masks OUTDIR     masks over the synthetic field of
+                                 mrtrix_fod_tractograms.sh (fibres winding
+                                 about z at radius 15-40 mm, |z| < 30 mm), and
+                                 per mask a .tck of two-point streamlines
+                                 sitting on the faces between its set and unset
+                                 voxels (and the image's outer faces), each
+                                 point a few float32 ulps from the face
 
 Values in JSON: float32 values as Python floats (exact), non-finite ones as
 the strings "nan", "inf", "-inf". "mask" is what MRtrix3 reads as true when it
 opens the image as a mask: a finite value with |value| >= 0.5 (it rounds half
 away from zero to a bool).
 """
+import gzip
 import json
 import os
 import sys
@@ -171,8 +179,97 @@ def volumes(out):
         json.dump(cases, f)
 
 
+# --- masks for the tractograms of mrtrix_fod_tractograms.sh ------------------
+
+def write_tck(path, streamlines):
+    body = b''.join(np.asarray(s, '<f4').tobytes() + np.full(3, np.nan, '<f4').tobytes() for s in streamlines)
+    body += np.full(3, np.inf, '<f4').tobytes()
+    head = 'mrtrix tracks\ndatatype: Float32LE\ncount: %d\nfile: . %%d\nEND\n' % len(streamlines)
+    offset = len(head % 0) + 8
+    text = (head % offset).encode()
+    open(path, 'wb').write(text + b'\0' * (offset - len(text)) + body)
+
+
+def grid_world(aff, shape):
+    ijk = np.indices(shape).reshape(3, -1).T.astype(np.float64)
+    return (ijk @ aff[:3, :3].T + aff[:3, 3]).reshape(shape + (3,))
+
+
+def ball(aff, shape, center, radius):
+    d = np.linalg.norm(grid_world(aff, shape) - np.asarray(center), axis=-1)
+    return d <= radius
+
+
+def face_points(aff, mask, rng, count):
+    """Points within a few ulps of the faces between set and unset voxels
+    (and of the image's outer faces next to set voxels)."""
+    shape = mask.shape
+    padded = np.pad(mask, 1)
+    faces = []
+    for axis in range(3):
+        for side in (-1, 1):
+            neighbour = np.roll(padded, -side, axis=axis)[1:-1, 1:-1, 1:-1]
+            for ijk in np.argwhere(mask & ~neighbour):
+                face = ijk.astype(np.float64)
+                face[axis] += 0.5 * side
+                faces.append(face)
+    faces = np.array(faces)
+    faces = faces[rng.choice(len(faces), min(count, len(faces)), replace=False)]
+    faces = np.repeat(faces, 4, axis=0)  # each with its own perturbation
+    world = faces @ aff[:3, :3].T + aff[:3, 3]
+    out = []
+    for p in world.astype(np.float32):
+        q = p.copy()
+        for k in range(3):
+            for _ in range(int(rng.integers(0, 4))):
+                q[k] = np.nextafter(q[k], np.float32(np.inf) if rng.integers(2) else np.float32(-np.inf))
+        out.append([q, q])
+    return out
+
+
+def masks(out):
+    rng = np.random.default_rng(41)
+    # RAS, 2 mm: a ball about (25, 0, 0), on the fibres' path.
+    ras = affine((0, 0, 0), (2.0, 2.0, 2.0), (-50.0, -50.0, -36.0))
+    shape = (51, 51, 37)
+    blob = ball(ras, shape, (25, 0, 0), 8.0)
+    nib.save(nib.Nifti1Image(blob.astype(np.uint8), ras, dtype=np.uint8), os.path.join(out, 'blob.nii'))
+    # Oblique, permuted and flipped (MRtrix3 realigns it), anisotropic: a
+    # ball about (0, 25, 0).
+    obl = affine((15, -10, 20), (1.7, 2.1, 2.5), (40.0, -45.0, -40.0), columns=(1, 0, 2), flips=(1, -1, 1))
+    oshape = (48, 44, 34)
+    centre = np.linalg.solve(obl[:3, :3], -obl[:3, 3])
+    obl[:3, 3] -= obl[:3, :3] @ (np.array(oshape) / 2 - centre)
+    oblique = ball(obl, oshape, (0, 25, 0), 7.0)
+    nib.save(nib.Nifti1Image(oblique.astype(np.uint8), obl, dtype=np.uint8), os.path.join(out, 'oblique.nii'))
+    # Non-binary float32: a bump of height 1 about (0, -25, 0) and one of
+    # height -1 about (-25, 0, 0); MRtrix3 keeps |value| >= 0.5.
+    w = grid_world(ras, shape)
+    bumps = (np.exp(-np.sum((w - [0, -25, 0]) ** 2, -1) / (2 * 6.0 ** 2)) -
+             np.exp(-np.sum((w - [-25, 0, 0]) ** 2, -1) / (2 * 5.0 ** 2))).astype(np.float32)
+    nib.save(nib.Nifti1Image(bumps, ras, dtype=np.float32), os.path.join(out, 'float.nii'))
+    # gzip, LAS storage (x flipped), int16 scaled by 0.01: set where the
+    # scaled value reaches 0.5, a ball about (0, 25, 0) and (25, 0, 0).
+    las = affine((0, 0, 0), (2.5, 2.5, 2.5), (50.0, -50.0, -37.5), flips=(-1, 1, 1))
+    lshape = (41, 41, 31)
+    level = np.maximum(100 * (1 - np.linalg.norm(grid_world(las, lshape) - [0, 25, 0], axis=-1) / 14),
+                       100 * (1 - np.linalg.norm(grid_world(las, lshape) - [25, 0, 0], axis=-1) / 10))
+    stored = np.clip(np.round(level), -10, 100).astype(np.int16)
+    img = nib.Nifti1Image(stored, las, dtype=np.int16)
+    img.header.set_slope_inter(0.01, 0.0)
+    nib.save(img, os.path.join(out, 'blob_gz.nii.gz'))
+    raw = gzip.open(os.path.join(out, 'blob_gz.nii.gz')).read()
+    assert np.isclose(np.frombuffer(raw[112:116], '<f4')[0], 0.01)
+
+    for name, path in [('blob', 'blob.nii'), ('oblique', 'oblique.nii'), ('float', 'float.nii'),
+                       ('blob_gz', 'blob_gz.nii.gz')]:
+        img = nib.load(os.path.join(out, path))
+        set_voxels = mrtrix_mask(img.get_fdata()).astype(bool)
+        write_tck(os.path.join(out, 'faces_' + name + '.tck'), face_points(img.affine, set_voxels, rng, 1000))
+
+
 if __name__ == '__main__':
-    if len(sys.argv) != 3 or sys.argv[1] != 'volumes':
+    if len(sys.argv) != 3 or sys.argv[1] not in ('volumes', 'masks'):
         sys.exit(__doc__)
     os.makedirs(sys.argv[2], exist_ok=True)
-    volumes(sys.argv[2])
+    (volumes if sys.argv[1] == 'volumes' else masks)(sys.argv[2])

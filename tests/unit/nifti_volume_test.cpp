@@ -1,7 +1,7 @@
 // NIfTI volumes (io/nifti_volume.h) against nibabel: files nibabel writes
 // (tests/tools/nifti_make.py volumes) give nibabel's affine, shape and
 // values; malformed files (cut, gzip-corrupt, headers patched here) are one
-// Error naming the file.
+// Error naming the file, from loadNiftiVolume and from `fibscope filter`.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -249,6 +249,29 @@ TEST_F(NiftiNibabel, badHeadersAreOneLineErrorsNamingTheFile) {
   std::filesystem::copy_file(file("pair.hdr"), tmp.file("short.hdr"));
   test::writeBytes(tmp.file("short.img"), test::readBytes(file("pair.img")).substr(0, 50));
   expectOneLineError(tmp.file("short.hdr"), tmp.file("short.img"), "truncated");
+}
+
+TEST_F(NiftiNibabel, filterWithABadMaskExitsTwoWithOneLineAndWritesNothing) {
+  TempDir tmp;
+  const std::string in = tmp.file("in.tck"), out = tmp.file("out.tck");
+  ASSERT_EQ(test::runFibscope("phantom " + in + " -n 20").exit_code, 0);
+  const std::string v1 = test::readBytes(file("dt_int16.nii"));
+  test::writeBytes(tmp.file("cut.nii"), v1.substr(0, v1.size() - 10));
+  test::writeBytes(tmp.file("magic.nii"), patched(v1, 344, int32_t(0x00636261)));
+  test::writeBytes(tmp.file("rgb.nii"), patched(v1, 70, int16_t(128)));
+  std::string gz = test::readBytes(file("gzipped.nii.gz"));
+  gz[gz.size() / 2] = char(gz[gz.size() / 2] ^ 0xff);
+  test::writeBytes(tmp.file("corrupt.nii.gz"), gz);
+  for (const std::string bad : {"cut.nii", "magic.nii", "rgb.nii", "corrupt.nii.gz", "missing.nii"}) {
+    for (const std::string option : {"--include", "--exclude", "--include-ordered"}) {
+      SCOPED_TRACE(option + " " + bad);
+      const auto r = test::runFibscope("filter " + in + " " + out + " " + option + " mask:" + tmp.file(bad));
+      EXPECT_EQ(r.exit_code, 2) << r.output;
+      EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+      EXPECT_NE(r.output.find(tmp.file(bad) + ": "), std::string::npos) << r.output;
+      EXPECT_FALSE(std::filesystem::exists(out));
+    }
+  }
 }
 
 }  // namespace
