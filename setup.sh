@@ -11,7 +11,7 @@ case "$mode" in run|test) ;; *) echo "usage: $0 run|test" >&2; exit 2 ;; esac
 
 # Build and run-time packages (Debian 12 names).
 packages=(g++ cmake ninja-build pkg-config libgtest-dev libbenchmark-dev libcli11-dev
-          nlohmann-json3-dev libzip-dev zlib1g-dev libglm-dev libtinyobjloader-dev)
+          nlohmann-json3-dev libzip-dev zlib1g-dev libglm-dev libtinyobjloader-dev libnifti2-dev)
 # Vulkan: loader and headers, the shader compiler, lavapipe (Vulkan on the CPU
 # where there is no GPU) and the validation layers (on in every GPU test).
 packages+=(libvulkan-dev glslc mesa-vulkan-drivers vulkan-validationlayers)

@@ -77,6 +77,7 @@ constexpr vec3 cross(vec3 a, vec3 b) {
 
 inline float abs(float v) { return std::fabs(v); }
 inline float floor(float v) { return std::floor(v); }
+inline float trunc(float v) { return std::trunc(v); }
 inline float min(float a, float b) { return a < b ? a : b; }
 inline float max(float a, float b) { return a > b ? a : b; }
 inline float clamp(float v, float lo, float hi) { return min(max(v, lo), hi); }

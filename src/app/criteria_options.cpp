@@ -25,7 +25,8 @@ std::vector<Region> regions(const std::vector<std::string>& specs, const char* o
 void addCriteriaCliOptions(CLI::App* cmd, CriteriaCliOptions& o) {
   cmd->add_option("--include", o.include,
                   "A region every kept streamline has a vertex in: sphere:X,Y,Z,R (or X,Y,Z,R), "
-                  "box:X0,Y0,Z0,X1,Y1,Z1 or obox:CX,CY,CZ,SX,SY,SZ,AX,AY,AZ (mm, degrees); repeatable");
+                  "box:X0,Y0,Z0,X1,Y1,Z1, obox:CX,CY,CZ,SX,SY,SZ,AX,AY,AZ (mm, degrees) or mask:FILE (a NIfTI "
+                  "image: its voxels >= 0.5, as tckedit reads a mask); repeatable");
   cmd->add_option("--include-ordered", o.include_ordered,
                   "Regions a kept streamline enters in the order given (tckedit -include_ordered); repeatable");
   cmd->add_option("--exclude", o.exclude, "A region no kept streamline has a vertex in; repeatable");

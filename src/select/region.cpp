@@ -48,6 +48,7 @@ bool regionContains(const Region& region, const float* p) {
       if (!(p[k] >= b->min[k] && p[k] <= b->max[k])) return false;
     return true;
   }
+  if (const auto* m = std::get_if<MaskRegion>(&region)) return m->mask->contains(p);
   // In float, as the GPU filter tests it (shared/fiber_filter.h): both
   // sides decide a vertex on a face alike.
   const OrientedBoxFloats f = orientedBoxFloats(std::get<OrientedBoxRegion>(region));
@@ -59,6 +60,11 @@ Region parseRegion(std::string_view spec) {
   const std::string text(spec);
   const size_t colon = spec.find(':');
   const std::string_view kind = colon == std::string_view::npos ? std::string_view("sphere") : spec.substr(0, colon);
+  if (kind == "mask") {
+    const std::string path(spec.substr(colon + 1));
+    if (path.empty()) fail(text, "expected a mask as mask:PATH (a NIfTI image)");
+    return MaskRegion{path, loadVoxelMask(path)};
+  }
   const std::string_view values = colon == std::string_view::npos ? spec : spec.substr(colon + 1);
   std::vector<double> v;
   const bool numbers = parseNumbers(values, v);
@@ -96,7 +102,7 @@ Region parseRegion(std::string_view spec) {
     }
     return o;
   }
-  fail(text, "unknown region kind '" + std::string(kind) + "' (expected sphere:, box: or obox:)");
+  fail(text, "unknown region kind '" + std::string(kind) + "' (expected sphere:, box:, obox: or mask:)");
 }
 
 std::string regionSpec(const Region& region) {
@@ -106,6 +112,7 @@ std::string regionSpec(const Region& region) {
   if (const auto* b = std::get_if<BoxRegion>(&region))
     return "box:" + number(b->min[0]) + "," + number(b->min[1]) + "," + number(b->min[2]) + "," + number(b->max[0]) +
            "," + number(b->max[1]) + "," + number(b->max[2]);
+  if (const auto* m = std::get_if<MaskRegion>(&region)) return "mask:" + m->path;
   const auto& o = std::get<OrientedBoxRegion>(region);
   std::string out = "obox:";
   for (const double x : {o.center[0], o.center[1], o.center[2], 2 * o.half[0], 2 * o.half[1], 2 * o.half[2],

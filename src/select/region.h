@@ -10,13 +10,19 @@
 //                       oriented box: centre, full sizes along its own axes,
 //                       and the rotation of those axes from x, y, z: AX
 //                       degrees about x, then AY about y, then AZ about z
+//   mask:PATH           a NIfTI image (.nii, .nii.gz, .hdr): its set voxels,
+//                       with tckedit's semantics (select/voxel_mask.h);
+//                       PATH is everything after "mask:", ':' and ',' too
 // Boundaries count as inside.
 #pragma once
 
 #include <array>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <variant>
+
+#include "select/voxel_mask.h"
 
 namespace fibscope {
 
@@ -38,17 +44,24 @@ struct OrientedBoxRegion {
   std::array<std::array<double, 3>, 3> axes = {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};  // from the angles: unit, orthogonal
 };
 
-using Region = std::variant<SphereRegion, BoxRegion, OrientedBoxRegion>;
+// Loaded once, when the spec is parsed; copies of the region share it.
+struct MaskRegion {
+  std::string path;
+  std::shared_ptr<const VoxelMask> mask;
+};
+
+using Region = std::variant<SphereRegion, BoxRegion, OrientedBoxRegion, MaskRegion>;
 
 // Whether world point p (mm) lies in the region.
 bool regionContains(const Region& region, const float* p);
 
 // The region a spec names. Throws Error "SPEC: ..." (one line: what was
 // expected) for anything else: an unknown kind, a wrong number of values,
-// non-finite values, a radius or size <= 0. Safe on untrusted text.
+// non-finite values, a radius or size <= 0; for a mask whose image cannot be
+// used, loadVoxelMask's Error "PATH: ...". Safe on untrusted text and files.
 Region parseRegion(std::string_view spec);
 // The spec of a region: parseRegion(regionSpec(r)) gives r again (to the
-// 9 significant digits printed).
+// 9 significant digits printed; a mask's file is read again).
 std::string regionSpec(const Region& region);
 
 }  // namespace fibscope

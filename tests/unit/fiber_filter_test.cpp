@@ -2,7 +2,7 @@
 // hand-made streamlines, and `fibscope filter` against MRtrix3's tckedit on
 // tractograms of a real tracker (iFOD1 and SD_Stream, 0.1 mm): the same
 // streamlines kept, in the same order, for spheres, ends-only, ordered
-// includes, excludes and length limits.
+// includes, excludes, length limits and NIfTI masks.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -129,6 +129,11 @@ class FilterAgainstTckedit : public ::testing::Test {
     const auto r = test::runCommand(test::toolPath("mrtrix_fod_tractograms.sh") + " " + dir_->path() + " 300");
     status_ = r.exit_code;
     output_ = r.output;
+    if (status_ != 0) return;
+    // Masks over the same field (the script has checked that nibabel is there).
+    const auto m = test::runCommand("/usr/bin/python3 " + test::toolPath("nifti_make.py") + " masks " + dir_->path());
+    status_ = m.exit_code == 0 ? 0 : 1;
+    output_ += m.output;
   }
   static void TearDownTestSuite() {
     delete dir_;
@@ -174,6 +179,49 @@ TEST_F(FilterAgainstTckedit, keepsTheSameStreamlinesInTheSameOrder) {
       const auto f = test::runFibscope("filter --force " + in + " " + got + " " + c.fibscope);
       ASSERT_EQ(f.exit_code, 0) << f.output;
       const Tractogram a = readTractogram(want), b = readTractogram(got);
+      ASSERT_EQ(b.streamlineCount(), a.streamlineCount()) << f.output;
+      EXPECT_EQ(b.offsets, a.offsets);
+      EXPECT_EQ(b.positions, a.positions);
+    }
+  }
+}
+
+TEST_F(FilterAgainstTckedit, masksKeepTheSameStreamlinesInTheSameOrder) {
+  // tests/tools/nifti_make.py masks: blob.nii a ball of 8 mm about (25,0,0)
+  // (RAS, 2 mm); oblique.nii one of 7 mm about (0,25,0) (rotated, permuted
+  // and flipped axes, anisotropic voxels); float.nii float32 bumps of +1
+  // about (0,-25,0) and -1 about (-25,0,0) (tckedit keeps |value| >= 0.5);
+  // blob_gz.nii.gz gzipped, LAS, int16 scaled by 0.01.
+  const auto m = [&](const std::string& name) { return dir_->file(name); };
+  struct Case {
+    std::string tckedit, fibscope;
+  };
+  const std::vector<Case> cases = {
+      {"-include " + m("blob.nii"), "--include mask:" + m("blob.nii")},
+      {"-include " + m("oblique.nii"), "--include mask:" + m("oblique.nii")},
+      {"-exclude " + m("oblique.nii"), "--exclude mask:" + m("oblique.nii")},
+      {"-include " + m("float.nii"), "--include mask:" + m("float.nii")},
+      {"-include " + m("float.nii") + " -ends_only", "--include mask:" + m("float.nii") + " --ends-only"},
+      {"-exclude " + m("blob_gz.nii.gz") + " -ends_only", "--exclude mask:" + m("blob_gz.nii.gz") + " --ends-only"},
+      {"-include " + m("blob_gz.nii.gz") + " -include 0,25,0,8",
+       "--include mask:" + m("blob_gz.nii.gz") + " --include sphere:0,25,0,8"},
+      {"-include " + m("oblique.nii") + " -exclude " + m("float.nii"),
+       "--include mask:" + m("oblique.nii") + " --exclude mask:" + m("float.nii")},
+      {"-include_ordered " + m("blob.nii") + " -include_ordered " + m("oblique.nii"),
+       "--include-ordered mask:" + m("blob.nii") + " --include-ordered mask:" + m("oblique.nii")},
+  };
+  for (const std::string input : {"ifod1.tck", "sdstream.tck"}) {
+    for (const Case& c : cases) {
+      SCOPED_TRACE(input + ": " + c.fibscope);
+      const std::string in = dir_->file(input), want = dir_->file("want.tck"), got = dir_->file("got.tck");
+      const auto t = test::runCommand("tckedit -quiet -force -nthreads 0 " + in + " " + want + " " + c.tckedit);
+      ASSERT_EQ(t.exit_code, 0) << t.output;
+      const auto f = test::runFibscope("filter --force " + in + " " + got + " " + c.fibscope);
+      ASSERT_EQ(f.exit_code, 0) << f.output;
+      const Tractogram all = readTractogram(in), a = readTractogram(want), b = readTractogram(got);
+      // Every case keeps some streamlines and drops others.
+      EXPECT_GT(a.streamlineCount(), 0u);
+      EXPECT_LT(a.streamlineCount(), all.streamlineCount());
       ASSERT_EQ(b.streamlineCount(), a.streamlineCount()) << f.output;
       EXPECT_EQ(b.offsets, a.offsets);
       EXPECT_EQ(b.positions, a.positions);
