@@ -4,21 +4,21 @@
 #define FIBSCOPE_GLSL_FILTER_REGIONS_GLSL
 
 #include "shared/fiber_filter.h"
+#include "shared/voxel_mask.h"
 
 layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer FilterRegionsRef { FilterRegion regions[]; };
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer FilterHitsRef { uvec4 hits[]; };
 layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer FilterMaskRef { uint words[]; };
 
-// kFilterMask: the voxel nearest to p (world -> voxel, then rounded
-// half up: floor(v + 0.5), as the CPU's maskContains); outside the image
-// is outside.
+// kFilterMask: the voxel p falls in by MRtrix3 tckedit's rule
+// (shared/voxel_mask.h, as the CPU's VoxelMask::contains); outside the
+// grid is outside.
 bool filterMaskContains(FilterRegion r, vec3 p) {
-  precise float vx = ((r.v[0] * p.x + r.v[1] * p.y) + r.v[2] * p.z) + r.v[3];
-  precise float vy = ((r.v[4] * p.x + r.v[5] * p.y) + r.v[6] * p.z) + r.v[7];
-  precise float vz = ((r.v[8] * p.x + r.v[9] * p.y) + r.v[10] * p.z) + r.v[11];
-  precise float rx = floor(vx + 0.5), ry = floor(vy + 0.5), rz = floor(vz + 0.5);
-  if (!(rx >= 0.0 && ry >= 0.0 && rz >= 0.0 && rx < float(r.nx) && ry < float(r.ny) && rz < float(r.nz))) return false;
-  const uint i = uint(rx) + r.nx * (uint(ry) + r.ny * uint(rz));
+  const float x = roundHalfAwayFromZero(voxelMaskCoordinate(vec4(r.v[0], r.v[1], r.v[2], r.v[3]), p));
+  const float y = roundHalfAwayFromZero(voxelMaskCoordinate(vec4(r.v[4], r.v[5], r.v[6], r.v[7]), p));
+  const float z = roundHalfAwayFromZero(voxelMaskCoordinate(vec4(r.v[8], r.v[9], r.v[10], r.v[11]), p));
+  if (!(x >= 0.0 && y >= 0.0 && z >= 0.0 && x < float(r.nx) && y < float(r.ny) && z < float(r.nz))) return false;
+  const uint i = uint(x) + r.nx * (uint(y) + r.ny * uint(z));
   return ((FilterMaskRef(r.mask).words[i >> 5u] >> (i & 31u)) & 1u) != 0u;
 }
 

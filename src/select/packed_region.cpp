@@ -3,7 +3,11 @@
 #include <cmath>
 #include <limits>
 
+#include <algorithm>
+#include <glm/glm.hpp>
+
 #include "core/error.h"
+#include "select/voxel_mask.h"
 
 namespace fibscope {
 namespace {
@@ -77,7 +81,44 @@ shader::FilterRegion packRegion(const Region& region) {
     }
     setBox(r, lo, hi);
   } else {
-    throw Error("filter: " + regionSpec(region) + ": this kind of region is packed with its voxels");
+    const VoxelMask& m = *std::get<MaskRegion>(region).mask;
+    r.kind = shader::kFilterMask;
+    r.nx = uint32_t(m.size[0]);
+    r.ny = uint32_t(m.size[1]);
+    r.nz = uint32_t(m.size[2]);
+    for (int i = 0; i < 3; ++i) {
+      const shader::vec4& row = m.world_to_voxel[i];
+      r.v[4 * i] = row.x;
+      r.v[4 * i + 1] = row.y;
+      r.v[4 * i + 2] = row.z;
+      r.v[4 * i + 3] = row.w;
+    }
+    // The grid's world box: its corners (voxel faces at -0.5 and size -
+    // 0.5) through the inverse of the rows, padded by setBox.
+    glm::dmat4 w2v(1.0);
+    for (int i = 0; i < 3; ++i)
+      for (int c = 0; c < 4; ++c) w2v[c][i] = r.v[4 * i + c];
+    const glm::dmat4 v2w = glm::inverse(w2v);
+    std::array<double, 3> lo, hi;
+    lo.fill(INFINITY);
+    hi.fill(-INFINITY);
+    for (int corner = 0; corner < 8; ++corner) {
+      const glm::dvec4 v((corner & 1 ? m.size[0] : 0) - 0.5, (corner & 2 ? m.size[1] : 0) - 0.5,
+                         (corner & 4 ? m.size[2] : 0) - 0.5, 1.0);
+      const glm::dvec4 w = v2w * v;
+      for (int k = 0; k < 3; ++k) {
+        lo[k] = std::min(lo[k], w[k]);
+        hi[k] = std::max(hi[k], w[k]);
+      }
+    }
+    // Half a voxel more: rounding to the nearest voxel reaches that far.
+    double voxel = 0;
+    for (int k = 0; k < 3; ++k) voxel = std::max(voxel, glm::length(glm::dvec3(v2w[k])));
+    for (int k = 0; k < 3; ++k) {
+      lo[k] -= voxel;
+      hi[k] += voxel;
+    }
+    setBox(r, lo, hi);
   }
   return r;
 }

@@ -13,8 +13,10 @@ namespace fibscope {
 // the doubles do (min rounded up, max rounded down); an oriented box is
 // tested in float (centre, half sizes and axes rounded to nearest), on the
 // CPU too (regionContains), so both sides run the same arithmetic.
-// Mask regions are packed by the GPU filter itself (their voxels go to a
-// buffer of their own).
+// A mask region gets its grid and world -> voxel rows (the
+// shared/voxel_mask.h rule, as the CPU's VoxelMask::contains) and its box;
+// its voxel bits (VoxelMask::bits) go to a buffer the caller makes, whose
+// address it stores in `mask`.
 shader::FilterRegion packRegion(const Region& region);
 // Sets r.box to [lo, hi] rounded outward (for regions packed elsewhere).
 void setRegionBox(shader::FilterRegion& r, const std::array<double, 3>& lo, const std::array<double, 3>& hi);

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <bit>
+#include <glm/glm.hpp>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -26,6 +27,7 @@
 #include "select/fiber_filter.h"
 #include "select/gpu/gpu_fiber_filter.h"
 #include "select/region.h"
+#include "select/voxel_mask.h"
 
 namespace fibscope {
 namespace {
@@ -39,6 +41,38 @@ struct Case {
 };
 
 std::string num(double v) { return std::to_string(v); }
+
+// A mask on an oblique grid of 2.5 mm voxels (rotated 25 degrees about z
+// and 10 about x) around (cx, cy, cz): the voxels of a ball of `radius` mm,
+// every seventh one left out, so its boundary is ragged.
+Region obliqueMask(double cx, double cy, double cz, double radius) {
+  auto mask = std::make_shared<VoxelMask>();
+  mask->path = "oblique-mask.nii";
+  const int n = int(std::ceil(2 * radius / 2.5)) + 3;
+  for (int k = 0; k < 3; ++k) mask->size[k] = n;
+  const double a = glm::radians(25.0), b = glm::radians(10.0), voxel = 2.5;
+  // voxel -> world: R * v * voxel + origin, origin so that the grid's centre is (cx, cy, cz).
+  const glm::dmat3 rz(std::cos(a), std::sin(a), 0, -std::sin(a), std::cos(a), 0, 0, 0, 1);
+  const glm::dmat3 rx(1, 0, 0, 0, std::cos(b), std::sin(b), 0, -std::sin(b), std::cos(b));
+  const glm::dmat3 linear = rz * rx * voxel;
+  const glm::dvec3 origin = glm::dvec3(cx, cy, cz) - linear * glm::dvec3(0.5 * (n - 1));
+  const glm::dmat3 inv = glm::inverse(linear);
+  const glm::dvec3 t = -(inv * origin);
+  for (int i = 0; i < 3; ++i)
+    mask->world_to_voxel[i] = {float(inv[0][i]), float(inv[1][i]), float(inv[2][i]), float(t[i])};
+  mask->bits.assign((size_t(n) * n * n + 31) / 32, 0);
+  size_t index = 0;
+  for (int z = 0; z < n; ++z)
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x, ++index) {
+        const glm::dvec3 w = linear * glm::dvec3(x, y, z) + origin;
+        if (glm::length(w - glm::dvec3(cx, cy, cz)) <= radius && index % 7 != 3) {
+          mask->bits[index / 32] |= 1u << (index % 32);
+          ++mask->set_voxels;
+        }
+      }
+  return MaskRegion{mask->path, mask};
+}
 
 std::vector<Case> casesFor(const Bounds& b) {
   const double cx = 0.5 * (b.min[0] + b.max[0]), cy = 0.5 * (b.min[1] + b.max[1]), cz = 0.5 * (b.min[2] + b.max[2]);
@@ -77,6 +111,14 @@ std::vector<Case> casesFor(const Bounds& b) {
     c.include_ordered = {box(-0.5, -0.5, 0.0, 0.5, 0.5, 0.5), box(-0.5, -0.5, -0.5, 0.5, 0.5, 0.0)};
     c.exclude = {sphere(0.3, 0, 0, 0.1)};
     c.ends_only = true;
+  });
+  add("include mask", [&](FilterCriteria& c) { c.include = {obliqueMask(cx, cy, cz + 0.1 * ez, 0.12 * ex)}; });
+  add("exclude mask, ends only", [&](FilterCriteria& c) {
+    c.exclude = {obliqueMask(cx, cy, cz + 0.35 * ez, 0.2 * ex)};
+    c.ends_only = true;
+  });
+  add("ordered masks", [&](FilterCriteria& c) {
+    c.include_ordered = {obliqueMask(cx, cy, cz + 0.3 * ez, 0.25 * ex), obliqueMask(cx, cy, cz - 0.2 * ez, 0.25 * ex)};
   });
   add("length limits", [&](FilterCriteria& c) {
     c.min_length_mm = 0.4 * ex;

@@ -98,16 +98,29 @@ void GpuFiberFilter::prepare(const FiberFilter& filter, uint32_t scene_fibers, u
     throw Error("filter: the GPU filter takes at most " + std::to_string(shader::kFilterMaxOrderedRegions) +
                 " ordered include regions");
   shader::FilterPassPush& push = packed.push;
+  for (gpu::Buffer& b : masks_) gpu::destroyBuffer(context_, b);
+  masks_.clear();
+  // A mask's voxel bits go to a buffer of their own (kept until the next update).
+  auto pack = [&](const Region& region) {
+    shader::FilterRegion r = packRegion(region);
+    if (const auto* m = std::get_if<MaskRegion>(&region)) {
+      const std::vector<uint32_t>& bits = m->mask->bits;
+      masks_.push_back(gpu::createBuffer(context_, std::max<size_t>(bits.size(), 1) * 4, gpu::MemoryUse::DeviceLocal));
+      gpu::uploadToBuffer(context_, masks_.back(), bits.data(), bits.size() * 4);
+      r.mask = masks_.back().address;
+    }
+    packed.regions.push_back(r);
+  };
   for (const Region& r : c.include) {
     setBit(push.include_lo, push.include_hi, uint32_t(packed.regions.size()));
-    packed.regions.push_back(packRegion(r));
+    pack(r);
   }
   for (const Region& r : c.exclude) {
     setBit(push.exclude_lo, push.exclude_hi, uint32_t(packed.regions.size()));
-    packed.regions.push_back(packRegion(r));
+    pack(r);
   }
   push.hit_regions = uint32_t(packed.regions.size());
-  for (const Region& r : c.include_ordered) packed.regions.push_back(packRegion(r));
+  for (const Region& r : c.include_ordered) pack(r);
   push.ordered_regions = uint32_t(c.include_ordered.size());
   push.ends_only = c.ends_only ? 1u : 0u;
   push.min_length = filter.minLength();
