@@ -14,6 +14,7 @@
 #include "app/commands.h"
 #include "app/render_options.h"
 #include "app/render_scene.h"
+#include "app/scene_cuts.h"
 #include "app/scene_filter.h"
 #include "core/error.h"
 #include "io/png_writer.h"
@@ -99,6 +100,8 @@ void runRender(const RenderCommandOptions& o) {
   applyScalarColoring(context, scene.fiblets, o.render, settings, gpu_scene);
   const SceneFilter filter(context, scene, criteria, o.render.dim_dropped);
   filter.apply(gpu_scene, settings.pipeline);
+  const SceneCuts cuts(context, o.render);
+  cuts.apply(gpu_scene);
   const Camera camera = cameraFor(o, scene, width, height);
   auto t = Clock::now();
   FrameRenderer& renderer = *device->renderer;
