@@ -25,6 +25,7 @@
 
 #include "core/tractogram.h"
 #include "select/region.h"
+#include "shared/fiber_filter.h"
 
 namespace fibscope {
 
@@ -70,7 +71,14 @@ class FiberFilter {
   float maxLength() const { return max_length_; }
 
  private:
+  // A region in the form the tests run on (select/packed_region.h: the
+  // floats and the box the GPU filter gets too), with its mask.
+  struct Packed {
+    shader::FilterRegion region;
+    const VoxelMask* mask = nullptr;
+  };
   FilterCriteria criteria_;
+  std::vector<Packed> include_, include_ordered_, exclude_;
   float min_length_ = -INFINITY, max_length_ = INFINITY;  // with the margin
 };
 
