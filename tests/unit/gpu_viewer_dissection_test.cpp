@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <glm/glm.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -245,6 +246,58 @@ TEST_F(GpuDissectionViewer, scriptedRoisExportWhatFibscopeFilterWritesAndTheSave
   EXPECT_EQ(litPixels(cut), 0u) << "the clip plane reached the frame";
   const Png shown = readOurPng(shown_png);
   EXPECT_EQ(shown.width, 480u);  // the window with the dissection panel open
+}
+
+// The right click (script: roi-place): a sphere centred on the fiber drawn
+// under the cursor, sized from the scene, that keeps the fibers through it.
+TEST_F(GpuDissectionViewer, placedSphereSitsOnTheFiberUnderTheCursor) {
+  // Where a fiber is drawn: the covered pixel (3x3) nearest the centre of
+  // the scene alone at the window's size and camera.
+  const std::string look = dir_.file("look.txt"), scene_png = dir_.file("scene.png"), cache = dir_.file("cache");
+  test::writeBytes(look, lines({"wait 1", "screenshot " + scene_png + " 160x120", "quit"}));
+  auto r = runViewer("--offscreen --size 160x120 --script " + look + " " + tck_, cache);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Png scene = readOurPng(scene_png);
+  ASSERT_EQ(scene.width, 160u);
+  auto covered = [&](uint32_t x, uint32_t y) {
+    for (uint32_t v = y - 1; v <= y + 1; ++v)
+      for (uint32_t u = x - 1; u <= x + 1; ++u)
+        if (std::max({scene.at(u, v)[0], scene.at(u, v)[1], scene.at(u, v)[2]}) <= 40) return false;
+    return true;
+  };
+  std::optional<std::pair<uint32_t, uint32_t>> at;
+  auto d2 = [](uint32_t x, uint32_t y) {
+    return (double(x) - 80) * (double(x) - 80) + (double(y) - 60) * (double(y) - 60);
+  };
+  for (uint32_t y = 1; y + 1 < 120; ++y)
+    for (uint32_t x = 1; x + 1 < 160; ++x)
+      if (covered(x, y) && (!at || d2(x, y) < d2(at->first, at->second))) at = {x, y};
+  ASSERT_TRUE(at.has_value()) << "nothing drawn";
+
+  const std::string place = dir_.file("place.txt"), set = dir_.file("placed.json"), kept = dir_.file("placed.tck");
+  test::writeBytes(place, lines({"wait 1", "roi-place " + std::to_string(at->first) + " " + std::to_string(at->second),
+                                 "roi-save " + set, "export-kept " + kept, "quit"}));
+  r = runViewer("--offscreen --size 160x120 --script " + place + " " + tck_, cache);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const RoiSet placed = loadRoiSet(set);
+  ASSERT_EQ(placed.rois.size(), 1u);
+  EXPECT_EQ(placed.rois[0].name, "sphere-1");
+  EXPECT_EQ(placed.rois[0].role, RoiRole::Include);
+  const auto& sphere = std::get<SphereRegion>(placed.rois[0].region);
+  const glm::dvec3 center(sphere.center[0], sphere.center[1], sphere.center[2]);
+  // On a fiber: the depth read back puts the centre within a line's width
+  // (here about 1 mm) of a point of the phantom.
+  double nearest = INFINITY;
+  for (size_t s = 0; s < phantom_.streamlineCount(); ++s) nearest = std::min(nearest, closest(s, center));
+  std::printf("placed at %.1f, %.1f, %.1f mm, radius %.2f mm, %.3f mm from the nearest point\n", center.x, center.y,
+              center.z, double(sphere.radius), nearest);
+  EXPECT_LT(nearest, 1.5);
+  // 3 % of the scene's diagonal (the phantom spans about 250 mm).
+  EXPECT_GT(sphere.radius, 4.0f);
+  EXPECT_LT(sphere.radius, 10.0f);
+  const Tractogram through = readAllStreamlines(*openTractogram(kept));
+  EXPECT_EQ(through.streamlineCount(), keptBy({Sphere{center, double(sphere.radius)}}).size());
+  EXPECT_GT(through.streamlineCount(), 0u);
 }
 
 TEST_F(GpuDissectionViewer, malformedRoiSetIsOneLineAndKeepsTheViewerAndItsState) {

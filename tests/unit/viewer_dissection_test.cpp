@@ -293,9 +293,10 @@ TEST(ViewerScript, parsesTheDissectionCommands) {
       "roi-save set.json\n"
       "roi-load set.json\n"
       "export-kept kept.trk\n"
-      "expect-kept 12\n",
+      "expect-kept 12\n"
+      "roi-place 30 40.5\n",
       "d.txt");
-  ASSERT_EQ(steps.size(), 16u);  // export-kept is followed by its wait
+  ASSERT_EQ(steps.size(), 17u);  // export-kept is followed by its wait
   auto edit_of = [&](size_t i) { return std::get<DissectionAction>(std::get<ViewerAction>(steps[i].command)).edit; };
   const auto add = std::get<RoiAddEdit>(edit_of(0));
   EXPECT_EQ(add.name, "cst");
@@ -325,6 +326,9 @@ TEST(ViewerScript, parsesTheDissectionCommands) {
   const auto& expect = std::get<ExpectKeptAction>(std::get<ViewerAction>(steps[15].command));
   EXPECT_EQ(expect.count, 12u);
   EXPECT_EQ(expect.where, "d.txt:15");
+  const auto& place = std::get<RoiPlaceAction>(std::get<ViewerAction>(steps[16].command));
+  EXPECT_EQ(place.x, 30);
+  EXPECT_EQ(place.y, 40.5);
 }
 
 TEST(ViewerScript, malformedDissectionLinesNameTheFileAndLine) {
@@ -350,7 +354,10 @@ TEST(ViewerScript, malformedDissectionLinesNameTheFileAndLine) {
                                 "export-kept kept.vtk",
                                 "export-kept",
                                 "expect-kept -3",
-                                "expect-kept 2.5"}) {
+                                "expect-kept 2.5",
+                                "roi-place 1",
+                                "roi-place -1 2",
+                                "roi-place a b"}) {
     SCOPED_TRACE(bad);
     try {
       parseScript("wait 1\n" + bad + "\n", "session.txt");

@@ -76,6 +76,14 @@ std::optional<ViewerAction> parseDissectionCommand(const std::vector<std::string
     add.region = parseRegion(w[3]);
     return ViewerAction{DissectionAction{add}};
   }
+  if (name == "roi-place") {
+    expectArguments(w, 2, 2, "roi-place X Y");
+    const double x = number(w[1], "X"), y = number(w[2], "Y");
+    if (!(x >= 0 && x < 65536 && y >= 0 && y < 65536))
+      throw Error("roi-place: expected window pixels from 0 to 65535, got " + std::string(w[1]) + " " +
+                  std::string(w[2]));
+    return ViewerAction{RoiPlaceAction{x, y}};
+  }
   if (name == "roi-remove") {
     expectArguments(w, 1, 1, "roi-remove NAME");
     return ViewerAction{DissectionAction{RoiRemoveEdit{std::string(w[1])}}};
@@ -243,9 +251,9 @@ std::variant<ViewerAction, WaitFrames, WaitLoaded, WaitExported> parseCommand(co
   }
   throw Error("unknown command '" + std::string(name) +
               "' (expected orbit, pan, dolly, view, fov, set, wait, wait-loaded, open, model, screenshot, "
-              "pick, clear-selection, export-selection, expect-selected, roi-add, roi-remove, roi-enable, "
-              "ends-only, length, clip-plane-add, clip-plane-clear, slab, dropped, roi-save, roi-load, export-kept, "
-              "expect-kept, resize or quit)");
+              "pick, clear-selection, export-selection, expect-selected, roi-add, roi-place, roi-remove, "
+              "roi-enable, ends-only, length, clip-plane-add, clip-plane-clear, slab, dropped, roi-save, roi-load, "
+              "export-kept, expect-kept, resize or quit)");
 }
 
 }  // namespace

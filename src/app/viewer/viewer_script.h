@@ -18,6 +18,7 @@
 //   resize W H                 (the window, or the offscreen image, in pixels)
 // the virtual dissection (dissection.h, viewer_dissection.h):
 //   roi-add NAME include|exclude|include_ordered SPEC   (select/region.h's SPEC; a new NAME)
+//   roi-place X Y              (a sphere on the fiber drawn at that window pixel: the right click)
 //   roi-remove NAME | roi-enable NAME on|off
 //   ends-only on|off | length MIN MAX   (mm, '-': no limit)
 //   clip-plane-add PX,PY,PZ,NX,NY,NZ    (keeps the side the normal points to) | clip-plane-clear
