@@ -134,7 +134,8 @@ std::vector<RoiClipPlane> clipPlanesFromSettings(const std::vector<std::array<do
     const double len = glm::length(n);
     if (!(len > 0)) continue;  // renderSettingsFrom gives unit normals; a zero one keeps nothing to convert
     const glm::dvec3 unit = n / len;
-    out.push_back(RoiClipPlane{ClipPlane{glm::vec3(-p[3] / len * unit), glm::vec3(unit)}, true});
+    // (+ 0: no "-0" in a saved set for a plane through the origin.)
+    out.push_back(RoiClipPlane{ClipPlane{glm::vec3(-p[3] / len * unit + glm::dvec3(0.0)), glm::vec3(unit)}, true});
   }
   return out;
 }

@@ -168,7 +168,7 @@ void cutsSection(ViewerState& state) {
   if (ImGui::Button("+ clip plane")) set.clip_planes.push_back(RoiClipPlane{planeFacingViewer(state.camera), true});
   if (!room) ImGui::EndDisabled();
   ImGui::SameLine();
-  ImGui::TextDisabled(room ? "through the focal point, facing you" : "at most 6 enabled");
+  ImGui::TextDisabled(room ? "at the focal point, facing you" : "at most 6 enabled");
   int remove = -1;
   for (size_t i = 0; i < set.clip_planes.size(); ++i) {
     RoiClipPlane& p = set.clip_planes[i];
