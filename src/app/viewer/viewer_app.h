@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "render/render_settings.h"
+#include "select/roi_set.h"
 
 namespace fibscope {
 
@@ -31,6 +32,10 @@ struct ViewerOptions {
   // settings' scalar range was given (--scalar-range): kept, where otherwise
   // each model shown sets it to its fibers' lengths.
   bool keep_scalar_range = false;
+  // The dissection to start with (--roi-set, --include ...: cmd_view.cpp);
+  // settings.clip_planes join its planes.
+  RoiSet dissection;
+  bool dim_dropped = false;
   bool validate = false;   // validation layers on; any message fails the run
   std::string device;
   RenderSettings settings;

@@ -25,4 +25,11 @@ void drawLoadingOverlay(const ViewerState& state);
 // shown while something is selected.
 void drawSelectionPanel(ViewerState& state, std::vector<ViewerAction>& actions);
 
+// viewer_ui_dissection.cpp: the dissection panel (ROIs, length limits, the
+// kept count, hide or dim, clip planes and slab, ROI set files, export of
+// the kept fibers, the mouse bindings) and the ROIs' outlines over the
+// scene (drawn whether the panel is open or not).
+void drawDissectionPanel(ViewerState& state, std::vector<ViewerAction>& actions);
+void drawDissectionOverlay(const ViewerState& state);
+
 }  // namespace fibscope
