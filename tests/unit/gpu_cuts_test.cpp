@@ -42,6 +42,15 @@ struct CutCase {
 };
 
 class GpuCuts : public test::GpuTest {
+ public:
+  // Pixels whose visibility keys differ between two renderers' frames.
+  size_t keysDiffering(const FrameRenderer& a, const FrameRenderer& b) {
+    const auto ka = downloadVisibility(context(), a.targets()), kb = downloadVisibility(context(), b.targets());
+    size_t differ = 0;
+    for (size_t i = 0; i < ka.size(); ++i) differ += ka[i] != kb[i];
+    return differ;
+  }
+
  protected:
   void SetUp() override {
     test::GpuTest::SetUp();
@@ -166,11 +175,7 @@ TEST_F(GpuCuts, twoPhaseCullingWithCutsGivesTheUnculledFrame) {
                        GpuScene{&upload_->dataset});
       const FrameStats stats = culled.render(camera, cutSettings(cut, CullingMode::TwoPhase, RenderPipeline::Compute, 2.0f),
                                              GpuScene{&upload_->dataset});
-      const auto a = downloadVisibility(context(), reference.targets());
-      const auto b = downloadVisibility(context(), culled.targets());
-      size_t differ = 0;
-      for (size_t i = 0; i < a.size(); ++i) differ += a[i] != b[i];
-      EXPECT_EQ(differ, 0u) << "visibility keys differ";
+      EXPECT_EQ(keysDiffering(reference, culled), 0u) << "visibility keys differ";
       drawn += stats.fiblets_drawn;
       total += stats.fiblets_total;
     }
@@ -254,11 +259,7 @@ TEST_F(GpuCuts, twoPhaseCullingWithAMeshCutGivesTheUnculledFrame) {
       none.line_width_px = two_phase.line_width_px = 2.0f;
       reference.render(camera, none, scene);
       const FrameStats stats = culled.render(camera, two_phase, scene);
-      const auto a = downloadVisibility(context(), reference.targets());
-      const auto b = downloadVisibility(context(), culled.targets());
-      size_t differ = 0;
-      for (size_t i = 0; i < a.size(); ++i) differ += a[i] != b[i];
-      EXPECT_EQ(differ, 0u) << "visibility keys differ";
+      EXPECT_EQ(keysDiffering(reference, culled), 0u) << "visibility keys differ";
       drawn += stats.fiblets_drawn;
       total += stats.fiblets_total;
     }
