@@ -100,6 +100,8 @@ void runRender(const RenderCommandOptions& o) {
   applyScalarColoring(context, scene.fiblets, o.render, settings, gpu_scene);
   const SceneFilter filter(context, scene, criteria, o.render.dim_dropped);
   filter.apply(gpu_scene, settings.pipeline);
+  if (settings.color == ColorMode::Scalar && !o.render.gave("scalar-range"))
+    filter.distanceRange(settings.scalar_min, settings.scalar_max);  // colour by distance: its range
   const SceneCuts cuts(context, o.render);
   cuts.apply(gpu_scene);
   const Camera camera = cameraFor(o, scene, width, height);

@@ -27,7 +27,7 @@ float lengthInFloat(const float* xyz, size_t n) {
 
 bool FilterCriteria::empty() const {
   return include.empty() && include_ordered.empty() && exclude.empty() && std::isnan(min_length_mm) &&
-         std::isnan(max_length_mm);
+         std::isnan(max_length_mm) && (!distance_zone || std::isnan(max_distance_mm));
 }
 
 float headerStepSize(const TractogramHeader& header) {
@@ -60,6 +60,38 @@ FiberFilter::FiberFilter(FilterCriteria criteria, float step_size_mm) : criteria
   pack(criteria_.include, include_);
   pack(criteria_.include_ordered, include_ordered_);
   pack(criteria_.exclude, exclude_);
+  if (criteria_.distance_zone) {
+    if (std::holds_alternative<MaskRegion>(*criteria_.distance_zone))
+      throw Error("filter: a distance zone is a point, a sphere, a box or an oriented box, not a mask");
+    zone_ = packRegion(*criteria_.distance_zone);
+    has_zone_ = true;
+    const double t = criteria_.max_distance_mm;
+    if (t < 0) throw Error("filter: the distance threshold must be >= 0 mm");
+    if (!std::isnan(t)) {
+      // A sphere's distances are from its centre, less its radius.
+      const float reach = zone_.kind == shader::kFilterSphere ? float(t) + zone_.v[3] : float(t);
+      max_zone_d2_ = reach * reach;
+    }
+  }
+}
+
+float FiberFilter::zoneDistance2(const float* xyz, size_t n) const {
+  const shader::FilterRegion& z = zone_;
+  const shader::vec3 a0(z.v[6], z.v[7], z.v[8]), a1(z.v[9], z.v[10], z.v[11]), a2(z.v[12], z.v[13], z.v[14]);
+  float best = INFINITY;
+  for (size_t i = 0; i < n; ++i) {
+    const float* p = xyz + 3 * i;
+    const float d2 = shader::filterDistance2(z.kind, z.v[0], z.v[1], z.v[2], z.v[3], z.v[4], z.v[5], a0, a1, a2,
+                                             shader::vec3(p[0], p[1], p[2]));
+    best = d2 < best ? d2 : best;
+  }
+  return best;
+}
+
+float FiberFilter::zoneDistance(const float* xyz, size_t n) const {
+  if (!has_zone_) return NAN;
+  const float d = std::sqrt(zoneDistance2(xyz, n)) - (zone_.kind == shader::kFilterSphere ? zone_.v[3] : 0.0f);
+  return d > 0 ? d : 0.0f;
 }
 
 FilterVerdict FiberFilter::evaluate(const float* xyz, size_t n) const {
@@ -69,6 +101,13 @@ FilterVerdict FiberFilter::evaluate(const float* xyz, size_t n) const {
 FilterVerdict FiberFilter::evaluate(const float* xyz, size_t n, float length) const {
   if (n == 0) length = NAN;
   if (!(length >= min_length_ && length <= max_length_)) return {FilterReason::Length, 0};
+  const FilterVerdict regions = evaluateRegions(xyz, n);
+  if (!regions.kept()) return regions;
+  if (has_zone_ && !(zoneDistance2(xyz, n) <= max_zone_d2_)) return {FilterReason::Distance, 0};
+  return {};
+}
+
+FilterVerdict FiberFilter::evaluateRegions(const float* xyz, size_t n) const {
   if (include_.empty() && include_ordered_.empty() && exclude_.empty()) return {};
   // The vertices tested: all, or the two ends.
   const size_t visits = criteria_.ends_only ? 2 : n;
