@@ -55,6 +55,9 @@ void runFilterCommand(const FilterOptions& o) {
   std::printf("wrote %s: %llu of %llu streamlines kept (%s), %llu points, %.2f s\n", o.output.c_str(),
               static_cast<unsigned long long>(r.kept), static_cast<unsigned long long>(r.streamlines),
               percent(r.kept, r.streamlines).c_str(), static_cast<unsigned long long>(r.kept_points), seconds);
+  if (r.groups_kept + r.groups_dropped > 0)
+    std::printf("  groups: %zu kept with their kept members renumbered, %zu dropped (no member kept)\n", r.groups_kept,
+                r.groups_dropped);
   auto dropped = [&](const std::string& what, uint64_t n) {
     std::printf("  dropped %llu (%s): %s\n", static_cast<unsigned long long>(n), percent(n, r.streamlines).c_str(),
                 what.c_str());

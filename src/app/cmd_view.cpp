@@ -33,8 +33,9 @@ struct ViewCommandOptions {
 
 // The dissection the viewer starts with: the --roi-set's (its planes and
 // slab are in the settings already: renderSettingsFrom), then the command
-// line's regions as ROIs, its ends-only and length limits winning.
-RoiSet startingDissection(const CriteriaCliOptions& o) {
+// line's regions as ROIs, its ends-only and length limits winning, and
+// --cut-mesh's cuts after the set's.
+RoiSet startingDissection(const CriteriaCliOptions& o, const std::vector<std::string>& cut_meshes) {
   criteriaFrom(o);  // bad specs, lengths or files: one line before any window
   RoiSet set;
   if (!o.roi_set.empty()) {
@@ -52,12 +53,22 @@ RoiSet startingDissection(const CriteriaCliOptions& o) {
   set.ends_only = set.ends_only || o.ends_only;
   if (!std::isnan(o.min_length)) set.min_length_mm = o.min_length;
   if (!std::isnan(o.max_length)) set.max_length_mm = o.max_length;
+  for (const std::string& spec : cut_meshes) {
+    try {
+      set.cut_meshes.push_back(RoiCutMesh{parseMeshCut(spec), true});
+    } catch (const Error& e) {
+      throw Error(std::string("--cut-mesh ") + e.what());
+    }
+  }
+  if (enabledCutMeshes(set) > kMaxCutMeshes)
+    throw Error("--cut-mesh: at most " + std::to_string(kMaxCutMeshes) + " cut meshes at once, got " +
+                std::to_string(enabledCutMeshes(set)));
   return set;
 }
 
 void runView(ViewCommandOptions o) {
   ViewerOptions v;
-  v.dissection = startingDissection(o.render.criteria);
+  v.dissection = startingDissection(o.render.criteria, o.render.cut_meshes);
   v.dim_dropped = o.render.dim_dropped;
   v.files = o.files;
   v.phantom_streamlines = o.render.phantom_streamlines;

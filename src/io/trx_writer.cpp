@@ -124,6 +124,7 @@ class TrxWriter final : public TractogramWriter {
   void write(const Tractogram& chunk) override;
   void finish() override;
   void setGroups(std::vector<Group> groups) override;
+  void renumberGroups(std::vector<Group> groups) override;
 
  private:
   std::unique_ptr<OutputFile> createMember(const std::string& member);
@@ -270,6 +271,18 @@ void TrxWriter::setGroups(std::vector<Group> groups) {
   if (finished_) fail(path_, "internal error: setGroups() after finish()");
   // The data per group of the header's groups goes with them.
   std::erase_if(like_.properties, [](const auto& kv) { return kv.first.rfind("dpg/", 0) == 0; });
+  like_.groups = std::move(groups);
+}
+
+void TrxWriter::renumberGroups(std::vector<Group> groups) {
+  if (finished_) fail(path_, "internal error: renumberGroups() after finish()");
+  // The data per group of the groups dropped goes with them.
+  std::erase_if(like_.properties, [&](const auto& kv) {
+    if (kv.first.rfind("dpg/", 0) != 0) return false;
+    const size_t slash = kv.first.find('/', 4);
+    const std::string group = kv.first.substr(4, slash == std::string::npos ? std::string::npos : slash - 4);
+    return std::none_of(groups.begin(), groups.end(), [&](const Group& g) { return g.name == group; });
+  });
   like_.groups = std::move(groups);
 }
 

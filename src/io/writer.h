@@ -39,6 +39,13 @@ class TractogramWriter {
   virtual void setGroups(std::vector<Group> groups) {
     if (!groups.empty()) warn(std::to_string(groups.size()) + " group(s) not written: the format has no groups");
   }
+  // The groups of the header the writer was made with, renumbered for the
+  // streamlines written (a filter's: each holds its kept members at their
+  // output indices; a group left out is dropped). Unlike setGroups, the data
+  // per group of the groups kept stays (it describes the group, not its
+  // members). Call before finish(). Formats without groups ignore it (they
+  // warned about the header's groups when made).
+  virtual void renumberGroups(std::vector<Group> groups) { (void)groups; }
   const std::vector<std::string>& warnings() const { return warnings_; }
 
  protected:

@@ -1,6 +1,7 @@
 #include "select/filter_run.h"
 
 #include <algorithm>
+#include <bit>
 #include <future>
 #include <thread>
 
@@ -33,6 +34,24 @@ void appendKeptStreamlines(const Tractogram& in, const std::vector<uint8_t>& kee
   }
 }
 
+std::vector<Group> renumberedGroups(const std::vector<Group>& groups, const std::vector<uint64_t>& kept) {
+  // rank[w]: the kept streamlines before word w.
+  std::vector<uint64_t> rank(kept.size() + 1, 0);
+  for (size_t w = 0; w < kept.size(); ++w) rank[w + 1] = rank[w] + uint64_t(std::popcount(kept[w]));
+  std::vector<Group> out;
+  for (const Group& g : groups) {
+    Group renumbered{g.name, {}};
+    for (const uint32_t s : g.streamlines) {
+      const size_t w = s / 64;
+      const uint64_t bit = uint64_t(1) << (s % 64);
+      if (w >= kept.size() || !(kept[w] & bit)) continue;
+      renumbered.streamlines.push_back(uint32_t(rank[w] + uint64_t(std::popcount(kept[w] & (bit - 1)))));
+    }
+    if (!renumbered.streamlines.empty()) out.push_back(std::move(renumbered));
+  }
+  return out;
+}
+
 FilterReport runFilter(TractogramReader& reader, TractogramWriter& writer, const FiberFilter& filter,
                        unsigned threads, const std::function<void(uint64_t)>& progress) {
   const FilterCriteria& c = filter.criteria();
@@ -44,6 +63,9 @@ FilterReport runFilter(TractogramReader& reader, TractogramWriter& writer, const
   Tractogram chunks[2], kept;
   std::vector<FilterVerdict> verdicts;
   std::vector<uint8_t> keep;
+  // Which input streamlines are kept, for the header's groups (a bit each).
+  const bool grouped = !reader.header().groups.empty();
+  std::vector<uint64_t> kept_bits;
   bool more = reader.read(chunks[0], kChunkPoints);
   for (int current = 0; more; current ^= 1) {
     const Tractogram& chunk = chunks[current];
@@ -75,6 +97,11 @@ FilterReport runFilter(TractogramReader& reader, TractogramWriter& writer, const
         case FilterReason::Distance: ++report.by_distance; break;
       }
     }
+    if (grouped) {
+      kept_bits.resize((report.streamlines + n + 63) / 64, 0);
+      for (size_t s = 0; s < n; ++s)
+        if (keep[s]) kept_bits[(report.streamlines + s) / 64] |= uint64_t(1) << ((report.streamlines + s) % 64);
+    }
     report.streamlines += n;
     report.points += chunk.pointCount();
     kept.clear();
@@ -88,6 +115,13 @@ FilterReport runFilter(TractogramReader& reader, TractogramWriter& writer, const
     writer.write(kept);
     more = next.get();
     if (progress) progress(reader.bytesRead());
+  }
+  if (grouped) {
+    const std::vector<Group>& groups = reader.header().groups;
+    std::vector<Group> renumbered = renumberedGroups(groups, kept_bits);
+    report.groups_kept = renumbered.size();
+    report.groups_dropped = groups.size() - renumbered.size();
+    writer.renumberGroups(std::move(renumbered));
   }
   return report;
 }

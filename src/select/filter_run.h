@@ -24,10 +24,15 @@ struct FilterReport {
   std::vector<uint64_t> by_include;      // per include region: dropped for missing it (the first missed)
   uint64_t by_order = 0;                 // dropped for the ordered includes (missed or out of order)
   uint64_t by_distance = 0;              // dropped for lying farther than the threshold from the zone
+  // The input header's groups (TRX): written renumbered, and those left
+  // without a kept member dropped.
+  size_t groups_kept = 0, groups_dropped = 0;
 };
 
 // Filters everything `reader` gives into `writer` (which the caller
-// finishes). `progress` is called after each chunk with the reader's
+// finishes). The groups of the reader's header become the kept members of
+// each at their output indices, in the group's order (writer.renumberGroups;
+// an empty group is dropped, as trx-python's select drops it). `progress` is called after each chunk with the reader's
 // bytes so far. `threads`: 0 = every core. Throws what the reader and the
 // writer throw.
 FilterReport runFilter(TractogramReader& reader, TractogramWriter& writer, const FiberFilter& filter,
@@ -36,5 +41,12 @@ FilterReport runFilter(TractogramReader& reader, TractogramWriter& writer, const
 // The streamlines of `in` whose `keep` entry is non-zero, with their data,
 // appended to `out` (whose arrays must be named as `in`'s).
 void appendKeptStreamlines(const Tractogram& in, const std::vector<uint8_t>& keep, Tractogram& out);
+
+// `groups` (indices into a stream of streamlines) for the output that
+// keeps those whose bit is set in `kept` (bit i of word i / 64: input
+// streamline i; an index beyond the bits counts as dropped): each group's
+// kept members renumbered to their rank among the kept, in the group's
+// order; a group with none left is dropped.
+std::vector<Group> renumberedGroups(const std::vector<Group>& groups, const std::vector<uint64_t>& kept);
 
 }  // namespace fibscope

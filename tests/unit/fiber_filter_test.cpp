@@ -307,5 +307,82 @@ TEST(FilterCommand, keepsDataArraysAndReportsWhatEachCriterionDropped) {
   EXPECT_EQ(kept.per_point[0].values, want.per_point[0].values);
 }
 
+// A TRX input's groups name input streamlines: the output's must name the
+// same streamlines at their new indices. Three groups: every even
+// streamline listed backwards (its order kept), the last 50, and three the
+// sphere drops (the group goes, with its data per group).
+TEST(FilterCommand, trxGroupsHoldTheirKeptMembersRenumbered) {
+  test::TempDir dir;
+  const std::string in = dir.file("in.trx"), out = dir.file("out.trx");
+  const Tractogram all = test::smallTractogram(300, 5);
+  const std::string sphere = "sphere:0,0,0,30";
+  FilterCriteria c;
+  c.include = {parseRegion(sphere)};
+  const FiberFilter filter(c);
+  std::vector<uint8_t> keep;
+  for (size_t s = 0; s < all.streamlineCount(); ++s)
+    keep.push_back(filter.evaluate(all.point(all.offsets[s]), all.pointsIn(s)).kept());
+  ASSERT_GT(std::count(keep.begin(), keep.end(), 1), 20);
+  ASSERT_LT(std::count(keep.begin(), keep.end(), 1), 280);
+  TractogramHeader header;
+  header.format = "trx";
+  Group even{"even", {}}, tail{"tail", {}}, dropped{"dropped", {}};
+  for (uint32_t s = 300; s-- > 0;)
+    if (s % 2 == 0) even.streamlines.push_back(s);
+  for (uint32_t s = 250; s < 300; ++s) tail.streamlines.push_back(s);
+  for (uint32_t s = 0; s < 300 && dropped.streamlines.size() < 3; ++s)
+    if (!keep[s]) dropped.streamlines.push_back(s);
+  header.groups = {even, tail, dropped};
+  header.properties.push_back({"dpg/even/mean.float32", "[1.5]"});
+  header.properties.push_back({"dpg/dropped/mean.float32", "[2.5]"});
+  writeTractogram(in, all, header);
+
+  const auto r = test::runFibscope("filter " + in + " " + out + " --include " + sphere);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("groups: 2 kept with their kept members renumbered, 1 dropped"), std::string::npos)
+      << r.output;
+  TractogramHeader got_header;
+  const Tractogram got = readTractogram(out, &got_header);
+  ASSERT_EQ(got_header.groups.size(), 2u);
+  for (const Group& want : {even, tail}) {
+    SCOPED_TRACE(want.name);
+    const auto g = std::find_if(got_header.groups.begin(), got_header.groups.end(),
+                                [&](const Group& x) { return x.name == want.name; });
+    ASSERT_NE(g, got_header.groups.end());
+    // The kept members, in the group's order; each output member's points
+    // are its input streamline's.
+    std::vector<uint32_t> members;
+    for (const uint32_t s : want.streamlines)
+      if (keep[s]) members.push_back(s);
+    ASSERT_FALSE(members.empty());
+    ASSERT_EQ(g->streamlines.size(), members.size());
+    for (size_t k = 0; k < members.size(); ++k) {
+      const uint32_t o = g->streamlines[k], s = members[k];
+      ASSERT_LT(o, got.streamlineCount());
+      ASSERT_EQ(got.pointsIn(o), all.pointsIn(s)) << "member " << k;
+      EXPECT_TRUE(std::equal(got.point(got.offsets[o]), got.point(got.offsets[o + 1]), all.point(all.offsets[s])))
+          << "member " << k << ": output streamline " << o << " is not input streamline " << s;
+    }
+  }
+  bool even_mean = false;
+  for (const auto& [key, value] : got_header.properties) {
+    EXPECT_NE(key.rfind("dpg/dropped/", 0), 0u) << key;
+    even_mean |= key == "dpg/even/mean.float32";
+  }
+  EXPECT_TRUE(even_mean) << "the kept group lost its data per group";
+}
+
+TEST(FilterRun, renumberedGroupsRankTheKeptMembersAcrossWords) {
+  std::vector<uint64_t> kept(3, 0);
+  for (const uint32_t s : {1u, 63u, 64u, 130u}) kept[s / 64] |= uint64_t(1) << (s % 64);
+  const std::vector<Group> got =
+      renumberedGroups({{"a", {130, 2, 64, 1, 500}}, {"none", {0, 65}}, {"b", {63}}}, kept);
+  ASSERT_EQ(got.size(), 2u);
+  EXPECT_EQ(got[0].name, "a");
+  EXPECT_EQ(got[0].streamlines, (std::vector<uint32_t>{3, 2, 0}));
+  EXPECT_EQ(got[1].name, "b");
+  EXPECT_EQ(got[1].streamlines, std::vector<uint32_t>{1});
+}
+
 }  // namespace
 }  // namespace fibscope

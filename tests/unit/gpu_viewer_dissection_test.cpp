@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <glm/glm.hpp>
 #include <optional>
 #include <string>
@@ -298,6 +299,87 @@ TEST_F(GpuDissectionViewer, placedSphereSitsOnTheFiberUnderTheCursor) {
   const Tractogram through = readAllStreamlines(*openTractogram(kept));
   EXPECT_EQ(through.streamlineCount(), keptBy({Sphere{center, double(sphere.radius)}}).size());
   EXPECT_GT(through.streamlineCount(), 0u);
+}
+
+// Mesh cuts from a script: a box about the phantom's middle, half its
+// extent each way. Hiding what lies outside it leaves a subset of the
+// uncut frame's covered pixels, and fewer; hiding what lies inside leaves
+// fewer too, and the two cuts share few pixels (only where a fiber inside
+// the box is in front of one outside, or the reverse, along the ray). The
+// saved set holds the cut and, loaded after a clear, draws the same frame.
+// A cut whose OBJ cannot be read is one line and adds nothing.
+TEST_F(GpuDissectionViewer, meshCutsHideInsideOrOutsideAndSurviveTheRoiSet) {
+  if (test::runCommand("command -v xvfb-run").exit_code != 0) GTEST_SKIP() << "xvfb-run is not installed";
+  glm::dvec3 lo(INFINITY), hi(-INFINITY);
+  for (size_t i = 0; i < phantom_.pointCount(); ++i)
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], double(phantom_.point(i)[k]));
+      hi[k] = std::max(hi[k], double(phantom_.point(i)[k]));
+    }
+  const glm::dvec3 c = 0.5 * (lo + hi), h = 0.25 * (hi - lo);
+  char box[160];
+  std::snprintf(box, sizeof box, "box:%.2f,%.2f,%.2f,%.2f,%.2f,%.2f", c.x - h.x, c.y - h.y, c.z - h.z, c.x + h.x,
+                c.y + h.y, c.z + h.z);
+  const std::string missing = dir_.file("no-such-mesh.obj"), set = dir_.file("cuts.json");
+  const std::string script = dir_.file("s.txt");
+  auto shot = [&](const char* name) { return "screenshot " + dir_.file(name) + " 160x120"; };
+  test::writeBytes(script, lines({
+                               shot("none.png"),
+                               std::string("cut-mesh-add ") + box + ":outside",
+                               shot("outside.png"),
+                               "cut-mesh-clear",
+                               std::string("cut-mesh-add ") + box + ":inside",
+                               "cut-mesh-add " + missing + ":outside",
+                               shot("inside.png"),
+                               "roi-save " + set,
+                               "cut-mesh-clear",
+                               shot("cleared.png"),
+                               "roi-load " + set,
+                               shot("reloaded.png"),
+                               "quit",
+                           }));
+  // In a window under Xvfb (the panel drawn with the cuts listed), the
+  // screenshots of the scene alone.
+  const auto r = runViewer("--size 240x160 --script " + script + " " + tck_, dir_.file("cache"), kXvfb);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  size_t missing_lines = 0;
+  for (size_t at = r.output.find(missing); at != std::string::npos; at = r.output.find(missing, at + 1)) ++missing_lines;
+  EXPECT_EQ(missing_lines, 1u) << r.output;
+
+  const Png none = readOurPng(dir_.file("none.png")), outside = readOurPng(dir_.file("outside.png"));
+  const Png inside = readOurPng(dir_.file("inside.png")), cleared = readOurPng(dir_.file("cleared.png"));
+  const Png reloaded = readOurPng(dir_.file("reloaded.png"));
+  auto lit = [](const Png& png, uint32_t x, uint32_t y) {
+    const uint8_t* p = png.at(x, y);
+    return std::max({p[0], p[1], p[2]}) > 40;
+  };
+  size_t n_none = 0, n_out = 0, n_in = 0, out_not_none = 0, in_not_none = 0, both = 0, reload_differs = 0;
+  for (uint32_t y = 0; y < none.height; ++y)
+    for (uint32_t x = 0; x < none.width; ++x) {
+      const bool a = lit(none, x, y), o = lit(outside, x, y), i = lit(inside, x, y);
+      n_none += a;
+      n_out += o;
+      n_in += i;
+      out_not_none += o && !a;
+      in_not_none += i && !a;
+      both += o && i;
+      reload_differs += std::memcmp(inside.at(x, y), reloaded.at(x, y), 3) != 0;
+    }
+  ASSERT_GT(n_none, 500u);
+  EXPECT_LT(n_out, n_none * 9 / 10) << "hiding outside the box hid little";
+  EXPECT_GT(n_out, 50u) << "hiding outside the box hid everything";
+  EXPECT_LT(n_in, n_none * 95 / 100) << "hiding inside the box hid little";
+  EXPECT_LE(out_not_none, n_none / 200) << "a cut drew pixels the uncut frame does not cover";
+  EXPECT_LE(in_not_none, n_none / 200);
+  EXPECT_LT(both, std::min(n_in, n_out)) << "inside and outside cut the same";
+  EXPECT_EQ(reload_differs, 0u) << "the loaded set does not draw the saved cut";
+  EXPECT_GT(litPixels(cleared), n_in) << "cut-mesh-clear left a cut";
+
+  const RoiSet saved = loadRoiSet(set);
+  ASSERT_EQ(saved.cut_meshes.size(), 1u) << "the unreadable OBJ was added";
+  EXPECT_EQ(saved.cut_meshes[0].cut.spec, box);
+  EXPECT_TRUE(saved.cut_meshes[0].cut.cull_inside);
+  EXPECT_TRUE(saved.cut_meshes[0].enabled);
 }
 
 TEST_F(GpuDissectionViewer, malformedRoiSetIsOneLineAndKeepsTheViewerAndItsState) {

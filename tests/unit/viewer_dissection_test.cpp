@@ -357,7 +357,12 @@ TEST(ViewerScript, malformedDissectionLinesNameTheFileAndLine) {
                                 "expect-kept 2.5",
                                 "roi-place 1",
                                 "roi-place -1 2",
-                                "roi-place a b"}) {
+                                "roi-place a b",
+                                "cut-mesh-add box:0,0,0,1,1,1",
+                                "cut-mesh-add box:0,0,0,1,1:inside",
+                                "cut-mesh-add sphere:0,0,0,1:around",
+                                "cut-mesh-add",
+                                "cut-mesh-clear all"}) {
     SCOPED_TRACE(bad);
     try {
       parseScript("wait 1\n" + bad + "\n", "session.txt");
@@ -397,6 +402,68 @@ InputEvent rightButton(bool pressed) {
   e.button = InputEvent::kRight;
   e.pressed = pressed;
   return e;
+}
+
+TEST(ViewerDissection, cutMeshesAreEditsUpToFourEnabledAndTravelWithTheSet) {
+  DissectionState d;
+  RenderSettings s;
+  const auto steps = parseScript("cut-mesh-add box:0,0,0,10,10,10:outside\ncut-mesh-add mesh:a.obj:inside\n"
+                                 "cut-mesh-clear\n", "s");
+  ASSERT_EQ(steps.size(), 3u);
+  const auto& add = std::get<CutMeshAddEdit>(std::get<DissectionAction>(std::get<ViewerAction>(steps[0].command)).edit);
+  EXPECT_EQ(add.cut.spec, "box:0,0,0,10,10,10");
+  EXPECT_FALSE(add.cut.cull_inside);
+  const auto& file = std::get<CutMeshAddEdit>(std::get<DissectionAction>(std::get<ViewerAction>(steps[1].command)).edit);
+  EXPECT_EQ(file.cut.spec, "mesh:a.obj");  // an OBJ path, ':' and all
+  EXPECT_TRUE(file.cut.cull_inside);
+  EXPECT_TRUE(std::holds_alternative<CutMeshClearEdit>(
+      std::get<DissectionAction>(std::get<ViewerAction>(steps[2].command)).edit));
+
+  for (int i = 0; i < 4; ++i) edit(d, s, CutMeshAddEdit{MeshCut{"sphere:0,0,0," + std::to_string(i + 1), i % 2 == 0}});
+  EXPECT_THROW(edit(d, s, CutMeshAddEdit{MeshCut{"sphere:0,0,0,9", true}}), Error);
+  EXPECT_EQ(d.set.cut_meshes.size(), 4u);
+  d.set.cut_meshes[0].enabled = false;  // a disabled one leaves room
+  edit(d, s, CutMeshAddEdit{MeshCut{"sphere:0,0,0,9", true}});
+  EXPECT_EQ(enabledCutMeshes(d.set), 4u);
+
+  test::TempDir dir;
+  saveRoiSet(roiSetToSave(d, s), dir.file("set.json"));
+  edit(d, s, CutMeshClearEdit{});
+  EXPECT_TRUE(d.set.cut_meshes.empty());
+  loadRoiSetIntoState(loadRoiSet(dir.file("set.json")), d, s);
+  ASSERT_EQ(d.set.cut_meshes.size(), 5u);
+  EXPECT_FALSE(d.set.cut_meshes[0].enabled);
+  EXPECT_EQ(d.set.cut_meshes[1].cut.spec, "sphere:0,0,0,2");
+  EXPECT_FALSE(d.set.cut_meshes[1].cut.cull_inside);
+  // Five enabled: refused, the state kept.
+  RoiSet five = d.set;
+  five.cut_meshes[0].enabled = true;
+  EXPECT_THROW(loadRoiSetIntoState(five, d, s), Error);
+  EXPECT_FALSE(d.set.cut_meshes[0].enabled);
+}
+
+TEST(ViewerDissection, cutSizeFollowsTheScene) {
+  Bounds b;
+  b.min = {0, 0, 0};
+  b.max = {100, 0, 0};
+  EXPECT_DOUBLE_EQ(defaultCutSize(b), 15.0);
+  b.max = {0, 0, 0};
+  EXPECT_DOUBLE_EQ(defaultCutSize(b), 1.0);
+}
+
+TEST(ViewerInput, droppedObjBecomesACutHidingItsOutsideOtherFilesOpen) {
+  InputMapper m;
+  InputEvent drop;
+  drop.type = InputEvent::Type::Drop;
+  drop.paths = {"/data/thalamus.OBJ", "/data/sub.tck"};
+  const auto a = m.map(drop, false, false);
+  ASSERT_EQ(a.size(), 2u);
+  const auto& cut = std::get<CutMeshAddEdit>(std::get<DissectionAction>(a[0]).edit).cut;
+  EXPECT_EQ(cut.spec, "/data/thalamus.OBJ");
+  EXPECT_FALSE(cut.cull_inside);
+  EXPECT_EQ(std::get<OpenAction>(a[1]).path, "/data/sub.tck");
+  EXPECT_FALSE(isObjPath("obj"));
+  EXPECT_TRUE(isObjPath("a.obj"));
 }
 
 TEST(ViewerInput, rightClickPlacesASphereAtThePress) {

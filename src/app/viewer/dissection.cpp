@@ -50,6 +50,11 @@ size_t enabledClipPlanes(const RoiSet& set) {
       std::count_if(set.clip_planes.begin(), set.clip_planes.end(), [](const RoiClipPlane& p) { return p.enabled; }));
 }
 
+size_t enabledCutMeshes(const RoiSet& set) {
+  return size_t(
+      std::count_if(set.cut_meshes.begin(), set.cut_meshes.end(), [](const RoiCutMesh& m) { return m.enabled; }));
+}
+
 void applyDissectionEdit(DissectionState& state, RenderSettings& settings, const DissectionEdit& edit) {
   RoiSet& set = state.set;
   std::visit(
@@ -88,6 +93,12 @@ void applyDissectionEdit(DissectionState& state, RenderSettings& settings, const
           settings.slab_mm = e.thickness_mm;
         } else if constexpr (std::is_same_v<E, DroppedEdit>) {
           state.dim_dropped = e.dim;
+        } else if constexpr (std::is_same_v<E, CutMeshAddEdit>) {
+          if (enabledCutMeshes(set) >= kMaxCutMeshes)
+            throw Error("cut-mesh-add: at most " + std::to_string(kMaxCutMeshes) + " cut meshes at once");
+          set.cut_meshes.push_back(RoiCutMesh{e.cut, true});
+        } else if constexpr (std::is_same_v<E, CutMeshClearEdit>) {
+          set.cut_meshes.clear();
         }
       },
       edit);
@@ -122,6 +133,8 @@ RoiSet roiSetToSave(const DissectionState& state, const RenderSettings& settings
 void loadRoiSetIntoState(RoiSet set, DissectionState& state, RenderSettings& settings) {
   if (enabledClipPlanes(set) > kMaxClipPlanes)
     throw Error("at most " + std::to_string(kMaxClipPlanes) + " clip planes may be enabled at once");
+  if (enabledCutMeshes(set) > kMaxCutMeshes)
+    throw Error("at most " + std::to_string(kMaxCutMeshes) + " cut meshes may be enabled at once");
   settings.slab_mm = set.slab ? set.slab->thickness_mm : 0.0f;
   state.set = std::move(set);
   state.selected = -1;
@@ -144,6 +157,11 @@ double defaultRoiRadius(const Bounds& scene) {
   const glm::dvec3 diagonal = vec(scene.max) - vec(scene.min);
   const double d = glm::length(diagonal);
   return std::max(0.5, std::isfinite(d) ? 0.03 * d : 0.5);
+}
+
+double defaultCutSize(const Bounds& scene) {
+  const double d = glm::length(vec(scene.max) - vec(scene.min));
+  return std::max(1.0, std::isfinite(d) ? 0.15 * d : 1.0);
 }
 
 SphereRegion sphereAt(const glm::dvec3& center, double radius) {

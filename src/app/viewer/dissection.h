@@ -6,11 +6,13 @@
 //
 // One owner per value: the slab's thickness is RenderSettings::slab_mm
 // (the settings panel and `set slab` edit it too); the state keeps the
-// set's slab "follow" word and its cut meshes and anatomy (not drawn by
-// the viewer yet) only so that a saved set says what the loaded one said.
+// set's slab "follow" word and its anatomy (not drawn by the viewer yet)
+// only so that a saved set says what the loaded one said. The set's cut
+// meshes are drawn: viewer_cuts.h uploads them.
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <variant>
@@ -20,6 +22,7 @@
 #include "render/camera.h"
 #include "render/render_settings.h"
 #include "select/roi_set.h"
+#include "shared/cut_mesh.h"
 
 namespace fibscope {
 
@@ -42,6 +45,13 @@ struct DissectionState {
   std::string export_path = "kept.tck";
   std::string file_message;  // one line: "saved ...", or the error of a load that failed
   bool exporting = false;    // an export runs (the frame loop sets it)
+  // The panel's mesh cut field and the last add's error (one line).
+  std::string cut_mesh_spec;
+  std::string cut_mesh_message;
+  // Per cut mesh spec (viewer_cuts.h fills it between frames): its closure
+  // warning (the cut may be approximate) or why it is not drawn; absent or
+  // "" when it is drawn as given.
+  std::map<std::string, std::string> cut_mesh_notes;
 };
 
 // --- edits (scripts; the panel edits the state directly) ------------------
@@ -74,22 +84,34 @@ struct SlabEdit {
 struct DroppedEdit {
   bool dim = false;
 };
+// A closed mesh cut (select/cuts.h's MeshCut), enabled. ViewerApp reads
+// and uploads its mesh before the edit is applied, so a spec whose file
+// cannot be read changes nothing.
+struct CutMeshAddEdit {
+  MeshCut cut;
+};
+struct CutMeshClearEdit {};
 using DissectionEdit = std::variant<RoiAddEdit, RoiRemoveEdit, RoiEnableEdit, EndsOnlyEdit, LengthEdit,
-                                    ClipPlaneAddEdit, ClipPlaneClearEdit, SlabEdit, DroppedEdit>;
+                                    ClipPlaneAddEdit, ClipPlaneClearEdit, SlabEdit, DroppedEdit, CutMeshAddEdit,
+                                    CutMeshClearEdit>;
 
 // Applies `edit` to the state (and, for the slab, to `settings`). Throws
 // Error (one line) and changes nothing for: a ROI name already used
 // (RoiAddEdit) or not found, no ROI selected for RoiRemoveEdit without a
 // name, a min length above the max or a negative one, a clip plane beyond
-// kMaxClipPlanes enabled ones, a negative or non-finite slab.
+// kMaxClipPlanes enabled ones, a cut mesh beyond kMaxCutMeshes enabled
+// ones, a negative or non-finite slab.
 void applyDissectionEdit(DissectionState& state, RenderSettings& settings, const DissectionEdit& edit);
 
 // The first ROI named `name`, or -1.
 int findRoi(const RoiSet& set, const std::string& name);
 // `base` followed by the first "-N" (N = 1, 2, ...) no ROI is named yet.
 std::string uniqueRoiName(const RoiSet& set, const std::string& base);
-// Enabled clip planes of the set.
+// Enabled clip planes and cut meshes of the set.
 size_t enabledClipPlanes(const RoiSet& set);
+size_t enabledCutMeshes(const RoiSet& set);
+// The cut meshes drawn at once (the cut stage's slots).
+inline constexpr size_t kMaxCutMeshes = shader::kMaxCutMeshes;
 
 // --- what the frame draws -------------------------------------------------
 
@@ -108,7 +130,7 @@ size_t addDissectionCuts(const RoiSet& set, RenderSettings& settings);
 RoiSet roiSetToSave(const DissectionState& state, const RenderSettings& settings);
 // Makes `set` the state (selection cleared) and its slab the settings'
 // slab_mm (0 without one). Throws Error (state unchanged) for more than
-// kMaxClipPlanes enabled planes.
+// kMaxClipPlanes enabled planes or kMaxCutMeshes enabled cut meshes.
 void loadRoiSetIntoState(RoiSet set, DissectionState& state, RenderSettings& settings);
 // The world (n, d) planes of the command line (RenderSettings::clip_planes)
 // as the set's clip planes (point = -d n, the point of the plane nearest
@@ -123,6 +145,10 @@ double defaultRoiRadius(const Bounds& scene);
 SphereRegion sphereAt(const glm::dvec3& center, double radius);
 // An axis-aligned cube of this half size about `center`.
 BoxRegion boxAt(const glm::dvec3& center, double half_size);
+// The half size (or radius) of the panel's built-in cut meshes: a cut
+// hides a part of the scene, so larger than a ROI: 15 % of the diagonal
+// (about 37 mm in a brain), at least 1 mm.
+double defaultCutSize(const Bounds& scene);
 // The centre of a sphere or box (an oriented box's centre); nullopt for a
 // mask (not moved by the mouse).
 std::optional<glm::dvec3> regionCenter(const Region& region);

@@ -22,6 +22,7 @@
 #include "app/viewer/orbit_controller.h"
 #include "app/viewer/presentation.h"
 #include "app/viewer/recent_files.h"
+#include "app/viewer/viewer_cuts.h"
 #include "app/viewer/viewer_dissection.h"
 #include "app/viewer/viewer_input.h"
 #include "app/viewer/viewer_script.h"
@@ -211,6 +212,7 @@ class ViewerApp {
   std::unique_ptr<ViewerSelection> selection_;
   std::unique_ptr<GpuSceneFiberLengths> scene_lengths_;  // the scalar colour mode's per-fiber values
   std::unique_ptr<ViewerDissection> dissection_;
+  std::unique_ptr<ViewerCuts> cuts_;  // the dissection's cut meshes on the GPU
   bool dissection_opened_ = false;  // the panel was opened for the dissection's first ROI or plane
   // The scene the G-buffer shows (the last frame drawn; no models after a
   // resize or a frame without a model): picks map its fiber ids to the
@@ -306,6 +308,7 @@ void ViewerApp::createFrameObjects() {
   selection_ = std::make_unique<ViewerSelection>(*context_);
   scene_lengths_ = std::make_unique<GpuSceneFiberLengths>(*context_);
   dissection_ = std::make_unique<ViewerDissection>(*context_);
+  cuts_ = std::make_unique<ViewerCuts>(*context_);
 
   VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
   alloc.commandPool = context_->commandPool();
@@ -345,6 +348,7 @@ void ViewerApp::release() {
   selection_.reset();
   scene_lengths_.reset();
   dissection_.reset();  // cancels an export
+  cuts_.reset();
   scenes_.clear();
   destroyPresentation(*context_, presentation_);
   if (swapchain_.swapchain != VK_NULL_HANDLE) gpu::destroySwapchain(*context_, swapchain_);
@@ -568,7 +572,9 @@ void ViewerApp::dissect(FrameScene& scene, bool now) {
     }
   }
   try {
-    finishFrame();  // an update rewrites the bits the frame in flight reads
+    finishFrame();  // an update rewrites the bits the frame in flight reads (and a sync frees meshes it may draw)
+    cuts_->sync(state_.dissection);
+    cuts_->apply(state_.dissection.set, scene.gpu);
     dissection_->evaluate(state_.dissection, d, now);
   } catch (const Error& e) {
     state_.status = e.what();
@@ -771,6 +777,15 @@ void ViewerApp::applyDissection(const ViewerAction& action) {
         [&](const auto& a) {
           using A = std::decay_t<decltype(a)>;
           if constexpr (std::is_same_v<A, DissectionAction>) {
+            if (const auto* add = std::get_if<CutMeshAddEdit>(&a.edit)) {
+              // The mesh read and uploaded first: a file that cannot be read changes nothing.
+              finishFrame();
+              const std::string warning = cuts_->prepare(add->cut.spec);
+              applyDissectionEdit(d, state_.settings, a.edit);
+              d.cut_mesh_message = warning.empty() ? "added cut " + meshCutSpec(add->cut) : warning;
+              report(d.cut_mesh_message);
+              return;
+            }
             applyDissectionEdit(d, state_.settings, a.edit);
           } else if constexpr (std::is_same_v<A, RoiSetFileAction>) {
             if (a.save) {
@@ -820,6 +835,8 @@ void ViewerApp::applyDissection(const ViewerAction& action) {
   } catch (const Error& e) {
     if (std::holds_alternative<ExpectKeptAction>(action)) throw;  // the script fails, naming its line
     if (std::holds_alternative<RoiSetFileAction>(action)) d.file_message = e.what();
+    if (const auto* edit = std::get_if<DissectionAction>(&action))
+      if (std::holds_alternative<CutMeshAddEdit>(edit->edit)) d.cut_mesh_message = e.what();
     report(e.what());
   }
 }
@@ -1090,7 +1107,8 @@ bool ViewerApp::drawFrame(uint32_t width, uint32_t height, double dt) {
   state_.camera = controller_.camera(width, height);  // the panel's focal point and the ROIs' outlines
   // The dissection panel opens with the first ROI or plane (once: closed
   // again, it stays closed).
-  if (!dissection_opened_ && (!state_.dissection.set.rois.empty() || !state_.dissection.set.clip_planes.empty())) {
+  if (!dissection_opened_ && (!state_.dissection.set.rois.empty() || !state_.dissection.set.clip_planes.empty() ||
+                              !state_.dissection.set.cut_meshes.empty())) {
     state_.show_dissection = true;
     dissection_opened_ = true;
   }

@@ -2,9 +2,18 @@
 
 #include <GLFW/glfw3.h>
 
+#include <cctype>
 #include <cmath>
+#include <string>
 
 namespace fibscope {
+
+bool isObjPath(std::string_view path) {
+  if (path.size() < 4) return false;
+  std::string ext(path.substr(path.size() - 4));
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".obj";
+}
 
 std::vector<ViewerAction> InputMapper::map(const InputEvent& e, bool want_mouse, bool want_keyboard) {
   std::vector<ViewerAction> actions;
@@ -108,7 +117,15 @@ std::vector<ViewerAction> InputMapper::map(const InputEvent& e, bool want_mouse,
       }
       break;
     case InputEvent::Type::Drop:
-      for (const std::string& path : e.paths) actions.push_back(OpenAction{path});
+      // A surface mesh becomes a cut keeping what lies inside it (the
+      // fibers through a structure, the question a dropped mesh usually
+      // asks; one click flips it); anything else opens as a model.
+      for (const std::string& path : e.paths) {
+        if (isObjPath(path))
+          actions.push_back(DissectionAction{CutMeshAddEdit{MeshCut{path, /*cull_inside=*/false}}});
+        else
+          actions.push_back(OpenAction{path});
+      }
       break;
   }
   return actions;

@@ -1,7 +1,8 @@
 // Mouse and keys to viewer actions, as mrview users expect: left drag
 // orbits, middle drag or shift + left drag pans, the wheel dollies; keys
 // 1/2/3 (or S/C/A) the sagittal, coronal and axial views, R resets,
-// F12 (or P) takes a screenshot; dropped files are opened. A left click
+// F12 (or P) takes a screenshot; dropped files are opened, a dropped .obj
+// becomes a mesh cut that hides what lies outside it. A left click
 // (press and release within kClickSlopPx) picks the fiber under it,
 // ctrl + click adds it to (or removes it from) the selection. The
 // dissection's ROIs: a right click places a sphere at the fiber under the
@@ -12,6 +13,7 @@
 #pragma once
 
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "app/viewer/viewer_actions.h"
@@ -30,6 +32,9 @@ struct InputEvent {
   bool shift = false, control = false;
   std::vector<std::string> paths;  // Drop
 };
+
+// Whether a dropped file is a surface mesh (".obj", any case): a cut, not a model.
+bool isObjPath(std::string_view path);
 
 class InputMapper {
  public:

@@ -110,6 +110,14 @@ std::optional<ViewerAction> parseDissectionCommand(const std::vector<std::string
     expectArguments(w, 0, 0, "clip-plane-clear");
     return ViewerAction{DissectionAction{ClipPlaneClearEdit{}}};
   }
+  if (name == "cut-mesh-add") {
+    expectArguments(w, 1, 1, "cut-mesh-add SPEC:inside|outside");
+    return ViewerAction{DissectionAction{CutMeshAddEdit{parseMeshCut(w[1])}}};
+  }
+  if (name == "cut-mesh-clear") {
+    expectArguments(w, 0, 0, "cut-mesh-clear");
+    return ViewerAction{DissectionAction{CutMeshClearEdit{}}};
+  }
   if (name == "slab") {
     expectArguments(w, 1, 1, "slab MM");
     const double mm = number(w[1], "MM");
@@ -252,7 +260,8 @@ std::variant<ViewerAction, WaitFrames, WaitLoaded, WaitExported> parseCommand(co
   throw Error("unknown command '" + std::string(name) +
               "' (expected orbit, pan, dolly, view, fov, set, wait, wait-loaded, open, model, screenshot, "
               "pick, clear-selection, export-selection, expect-selected, roi-add, roi-place, roi-remove, "
-              "roi-enable, ends-only, length, clip-plane-add, clip-plane-clear, slab, dropped, roi-save, roi-load, "
+              "roi-enable, ends-only, length, clip-plane-add, clip-plane-clear, cut-mesh-add, cut-mesh-clear, slab, "
+              "dropped, roi-save, roi-load, "
               "export-kept, expect-kept, resize or quit)");
 }
 

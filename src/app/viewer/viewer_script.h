@@ -22,6 +22,9 @@
 //   roi-remove NAME | roi-enable NAME on|off
 //   ends-only on|off | length MIN MAX   (mm, '-': no limit)
 //   clip-plane-add PX,PY,PZ,NX,NY,NZ    (keeps the side the normal points to) | clip-plane-clear
+//   cut-mesh-add SPEC:inside|outside    (an OBJ path or box:/obox:/sphere:, select/cut_mesh.h; hides what lies
+//                              inside or outside it; a file that cannot be read is one line, nothing added)
+//   cut-mesh-clear
 //   slab MM                    (around the focal plane; 0: none) | dropped hide|dim
 //   roi-save FILE.json | roi-load FILE.json   (a load that fails keeps the state, the error is shown)
 //   export-kept OUT.tck|.trk|.trx  (the active model's kept fibers, as `fibscope filter`; holds until written)

@@ -1,6 +1,7 @@
 // The dissection panel (dissection.h): the ROIs with their roles, placed at
 // the focal point and edited numerically; ends only and length limits; the
-// kept count and how dropped fibers are shown; clip planes and the slab;
+// kept count and how dropped fibers are shown; clip planes, the slab and
+// mesh cuts (viewer_cuts.h);
 // saving and loading the ROI set; exporting the kept fibers. And the ROIs'
 // outlines over the scene, so that the mouse has something to aim at.
 #include <imgui.h>
@@ -161,7 +162,64 @@ void lengthLimit(const char* label, double& value, double fallback) {
   ImGui::PopID();
 }
 
-void cutsSection(ViewerState& state) {
+// The mesh cuts: a spec typed (an OBJ path or a built-in shape) or a box or
+// sphere at the focal point; each with its side, on/off and its closure
+// note. Adding goes through an action (the mesh is read and uploaded
+// first); the rest edits the set.
+void cutMeshes(ViewerState& state, std::vector<ViewerAction>& actions) {
+  DissectionState& d = state.dissection;
+  RoiSet& set = d.set;
+  const bool room = enabledCutMeshes(set) < kMaxCutMeshes;
+  auto add = [&](const std::string& spec, bool cull_inside) {
+    actions.push_back(DissectionAction{CutMeshAddEdit{MeshCut{spec, cull_inside}}});
+  };
+  if (!room) ImGui::BeginDisabled();
+  const double size = defaultCutSize(state.scene_bounds);
+  if (ImGui::Button("+ cut box")) add(regionSpec(boxAt(focalPoint(state), size)), true);
+  ImGui::SameLine();
+  if (ImGui::Button("+ cut sphere")) add(regionSpec(sphereAt(focalPoint(state), size)), true);
+  ImGui::SameLine();
+  ImGui::TextDisabled(room ? "at the focal point" : "at most 4 enabled");
+  ImGui::SetNextItemWidth(-60);
+  const bool entered = ImGui::InputTextWithHint("##cutspec", "cut.obj:outside | box:X0,Y0,Z0,X1,Y1,Z1:inside",
+                                                &d.cut_mesh_spec, ImGuiInputTextFlags_EnterReturnsTrue);
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("SPEC:inside|outside; SPEC an OBJ file or box:, obox:, sphere: as for regions");
+  ImGui::SameLine();
+  if ((ImGui::Button("Add") || entered) && !d.cut_mesh_spec.empty()) {
+    try {
+      const MeshCut cut = parseMeshCut(d.cut_mesh_spec);
+      add(cut.spec, cut.cull_inside);
+    } catch (const Error& e) {
+      d.cut_mesh_message = e.what();
+    }
+  }
+  if (!room) ImGui::EndDisabled();
+  if (!d.cut_mesh_message.empty()) ImGui::TextWrapped("%s", d.cut_mesh_message.c_str());
+  int remove = -1;
+  for (size_t i = 0; i < set.cut_meshes.size(); ++i) {
+    RoiCutMesh& m = set.cut_meshes[i];
+    ImGui::PushID(int(i) + 1000);
+    bool enabled = m.enabled;
+    if (ImGui::Checkbox("##on", &enabled) && (!enabled || room)) m.enabled = enabled;
+    ImGui::SameLine();
+    int side = m.cut.cull_inside ? 0 : 1;
+    ImGui::SetNextItemWidth(110);
+    const char* const sides[] = {"hide inside", "hide outside"};
+    if (ImGui::Combo("##side", &side, sides, 2)) m.cut.cull_inside = side == 0;
+    ImGui::SameLine();
+    if (ImGui::SmallButton("x")) remove = int(i);
+    ImGui::SameLine();
+    ImGui::TextUnformatted(m.cut.spec.c_str());
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", m.cut.spec.c_str());
+    const auto note = d.cut_mesh_notes.find(m.cut.spec);
+    if (note != d.cut_mesh_notes.end() && !note->second.empty()) ImGui::TextColored(kWarning, "%s", note->second.c_str());
+    ImGui::PopID();
+  }
+  if (remove >= 0) set.cut_meshes.erase(set.cut_meshes.begin() + remove);
+}
+
+void cutsSection(ViewerState& state, std::vector<ViewerAction>& actions) {
   RoiSet& set = state.dissection.set;
   const bool room = enabledClipPlanes(set) < kMaxClipPlanes;
   if (!room) ImGui::BeginDisabled();
@@ -197,9 +255,8 @@ void cutsSection(ViewerState& state) {
   if (set.slab && !set.slab->follow.empty())
     ImGui::TextColored(kWarning, "the set's slab follows the %s slice: drawn about the focal plane for now",
                        set.slab->follow.c_str());
-  if (!set.cut_meshes.empty() || !set.anatomy.empty())
-    ImGui::TextDisabled("%zu cut mesh(es)%s kept in the set, not drawn here yet", set.cut_meshes.size(),
-                        set.anatomy.empty() ? "" : " and the anatomy");
+  cutMeshes(state, actions);
+  if (!set.anatomy.empty()) ImGui::TextDisabled("the set's anatomy is kept in the set, not drawn here yet");
 }
 
 void filesSection(ViewerState& state, std::vector<ViewerAction>& actions) {
@@ -276,7 +333,7 @@ void drawDissectionPanel(ViewerState& state, std::vector<ViewerAction>& actions)
         d.set.min_length_mm > d.set.max_length_mm)
       d.set.max_length_mm = d.set.min_length_mm;
   }
-  if (ImGui::CollapsingHeader("Cuts", ImGuiTreeNodeFlags_DefaultOpen)) cutsSection(state);
+  if (ImGui::CollapsingHeader("Cuts", ImGuiTreeNodeFlags_DefaultOpen)) cutsSection(state, actions);
   if (ImGui::CollapsingHeader("Files", ImGuiTreeNodeFlags_DefaultOpen)) filesSection(state, actions);
   if (ImGui::CollapsingHeader("Mouse")) {
     ImGui::TextWrapped(
