@@ -13,6 +13,7 @@ FrameStageList standardFrameStages() {
       makeLinesStage,
       // Surfaces into the surface target, then merged by depth.
       makeSphereStage,
+      makeAnatomyStage,
       makeSurfaceMergeStage,
   };
   for (FrameStageFactory& f : shadingStages()) list.push_back(std::move(f));

@@ -23,6 +23,8 @@ std::unique_ptr<FrameStage> makeRawComputeStage(const gpu::VulkanContext& contex
 std::unique_ptr<FrameStage> makeLinesStage(const gpu::VulkanContext& context);
 // Surfaces: "spheres", GpuScene::spheres ray-cast (sphere_surface.comp).
 std::unique_ptr<FrameStage> makeSphereStage(const gpu::VulkanContext& context);
+// Surfaces: "slices", GpuScene::anatomy's slices ray-cast (anatomy_slices.comp).
+std::unique_ptr<FrameStage> makeAnatomyStage(const gpu::VulkanContext& context);
 // "surface merge": the surface target into the G-buffer (surface_merge.comp).
 std::unique_ptr<FrameStage> makeSurfaceMergeStage(const gpu::VulkanContext& context);
 // Shading (shading_stages.h).
