@@ -11,6 +11,7 @@
 #include <optional>
 #include <string>
 
+#include "app/anatomy_options.h"
 #include "app/commands.h"
 #include "app/render_options.h"
 #include "app/render_scene.h"
@@ -67,6 +68,7 @@ void runRender(const RenderCommandOptions& o) {
   const FilterCriteria criteria = criteriaFrom(o.render.criteria).criteria;  // bad specs before any work
   uint32_t width = 0, height = 0;
   parseFrameSize(o.render.size, width, height);
+  const std::optional<NiftiVolume> volume = readAnatomyOption(o.render);  // a bad file before any work
 
   // The instance, the device and the frame renderer's pipelines (lavapipe
   // compiles every shader with LLVM here) take ~0.15 s on one core: made on
@@ -99,7 +101,12 @@ void runRender(const RenderCommandOptions& o) {
   applyScalarColoring(context, scene.fiblets, o.render, settings, gpu_scene);
   const SceneFilter filter(context, scene, criteria, o.render.dim_dropped);
   filter.apply(gpu_scene, settings.pipeline);
-  const Camera camera = cameraFor(o, scene, width, height);
+  GpuAnatomy anatomy;
+  if (volume) {
+    RenderSettings* fitted[] = {&settings};
+    applyAnatomy(context, *volume, o.render, fitted, anatomy, gpu_scene);
+  }
+  const Camera camera = withAnatomyInView(cameraFor(o, scene, width, height), anatomy);
   auto t = Clock::now();
   FrameRenderer& renderer = *device->renderer;
   const FrameStats stats = renderer.render(camera, settings, gpu_scene);

@@ -52,6 +52,9 @@ void addRenderCliOptions(CLI::App* cmd, RenderCliOptions& o) {
   cmd->add_option("--clip-plane", o.clip_planes,
                   "Draw only the side of the plane through PX,PY,PZ that the normal NX,NY,NZ points to (mm); "
                   "fibers are clipped at the plane; repeatable, at most 6");
+  cmd->add_option("--anatomy", o.anatomy,
+                  "NIfTI volume (.nii, .nii.gz: T1, FA, ...) shown as its three voxel-plane slices (--slice-i/j/k, "
+                  "--anatomy-range, --anatomy-opacity)");
   cmd->add_flag("--dim-dropped", o.dim_dropped,
                 "Draw the fibers the criteria drop dimmed (the kept ones highlighted) instead of hiding them");
   cmd->add_option("--device", o.device, "Vulkan device whose name contains this");
