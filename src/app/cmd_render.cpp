@@ -139,6 +139,8 @@ void addRenderCommand(CLI::App& app) {
   // culling would draw everything in its first phase and then only add a
   // depth pyramid and a second cull. The frustum test and LoD still pay.
   o->render.defaults.culling = CullingMode::Frustum;
+  // So that nobody mistakes left for right (--no-orientation-labels).
+  o->render.defaults.orientation_labels = true;
   addRenderCliOptions(cmd, o->render);
   cmd->add_option("--view", o->view, "sagittal | coronal | axial");
   cmd->add_option("--camera", o->camera, "AZ,EL,DIST: orbit angles in degrees and distance factor (0: framed snugly, 1: the bounding sphere fits)");

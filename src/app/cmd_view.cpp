@@ -56,6 +56,7 @@ void runView(ViewCommandOptions o) {
 void addViewCommand(CLI::App& app) {
   auto o = std::make_shared<ViewCommandOptions>();
   o->render.size = "1280x800";
+  o->render.defaults.orientation_labels = true;  // --no-orientation-labels
   CLI::App* cmd = app.add_subcommand("view", "Open the interactive viewer on tractograms (none: the built-in phantom)");
   addRenderCliOptions(cmd, o->render);
   // The viewer opens several files: the positional takes them all.

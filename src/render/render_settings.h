@@ -136,6 +136,11 @@ struct RenderSettings {
   // slice's world plane (the frame renderer sets it).
   SliceAxis active_slice = SliceAxis::K;
   bool slab_follows_slice = false;
+  // L/R, A/P, S/I at the middle of the image's edges and an axis triad in
+  // the bottom-right corner (x red, y green, z blue), stamped over the final
+  // image (render/orientation_labels.h). Off here; `render` and `view`
+  // turn it on by default.
+  bool orientation_labels = false;
 };
 
 // The slice position by axis (0 = i, 1 = j, 2 = k).

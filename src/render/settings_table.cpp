@@ -166,6 +166,9 @@ std::vector<SettingInfo> makeTable() {
                      "Draw only a slab this thick around the focal plane (moving with the view), or around the "
                      "active anatomical slice with --slab-follows-slice, mm; 0: off",
                      &RenderSettings::slab_mm, 0, 1000, "mm"));
+  t.push_back(flag("orientation-labels", "orientation labels",
+                   "L/R, A/P, S/I at the image's edges and an axis triad (x red, y green, z blue) in a corner",
+                   &RenderSettings::orientation_labels));
   // Anatomical slices (--anatomy; the viewer's anatomy panel).
   auto anatomy = [&](SettingInfo info) {
     info.group = "anatomy";

@@ -17,6 +17,7 @@ FrameStageList standardFrameStages() {
       makeSurfaceMergeStage,
   };
   for (FrameStageFactory& f : shadingStages()) list.push_back(std::move(f));
+  list.push_back(makeOrientationStage);  // over the final image
   return list;
 }
 
