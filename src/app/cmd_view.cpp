@@ -12,6 +12,7 @@
 #include "app/render_options.h"
 #include "app/viewer/viewer_app.h"
 #include "core/error.h"
+#include "render/settings_table.h"
 
 namespace fibscope {
 namespace {
@@ -34,6 +35,9 @@ void runView(ViewCommandOptions o) {
   parseFrameSize(o.render.size, v.width, v.height);
   v.settings = renderSettingsFrom(o.render);
   v.keep_scalar_range = o.render.gave("scalar-range");
+  v.anatomy = o.render.anatomy;
+  for (const SettingInfo& info : renderSettingsTable())
+    if (o.render.gave(info.name)) v.given_settings.insert(std::string(info.name));
   if (!o.screenshot.empty() && (o.screenshot.size() < 5 || o.screenshot.substr(o.screenshot.size() - 4) != ".png"))
     throw Error("--screenshot: the output must be a .png file, got '" + o.screenshot + "'");
   v.screenshot = o.screenshot;

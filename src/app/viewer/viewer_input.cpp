@@ -3,6 +3,9 @@
 #include <GLFW/glfw3.h>
 
 #include <cmath>
+#include <string>
+
+#include "app/viewer/viewer_anatomy.h"
 
 namespace fibscope {
 
@@ -70,12 +73,27 @@ std::vector<ViewerAction> InputMapper::map(const InputEvent& e, bool want_mouse,
         case GLFW_KEY_P:
           actions.push_back(ScreenshotAction{});  // empty path: the viewer picks a fresh name
           break;
+        // Anatomical slices (1/2/3 are the views): I/J/K choose the active
+        // slice, Page Up/Down move it a voxel (ten with shift).
+        case GLFW_KEY_I:
+        case GLFW_KEY_J:
+        case GLFW_KEY_K:
+          actions.push_back(SetAction{"active-slice", std::string(1, char('i' + (e.key - GLFW_KEY_I)))});
+          break;
+        case GLFW_KEY_PAGE_UP:
+        case GLFW_KEY_PAGE_DOWN:
+          actions.push_back(SliceStepAction{(e.key == GLFW_KEY_PAGE_UP ? 1.0 : -1.0) * (e.shift ? 10.0 : 1.0)});
+          break;
         default:
           break;
       }
       break;
     case InputEvent::Type::Drop:
-      for (const std::string& path : e.paths) actions.push_back(OpenAction{path});
+      // Images go to the anatomy, the rest to the model list.
+      for (const std::string& path : e.paths) {
+        if (isNiftiPath(path)) actions.push_back(AnatomyAction{path});
+        else actions.push_back(OpenAction{path});
+      }
       break;
   }
   return actions;

@@ -1,7 +1,9 @@
 // Mouse and keys to viewer actions, as mrview users expect: left drag
 // orbits, middle drag or shift + left drag pans, the wheel dollies; keys
 // 1/2/3 (or S/C/A) the sagittal, coronal and axial views, R resets,
-// F12 (or P) takes a screenshot; dropped files are opened. A left click
+// F12 (or P) takes a screenshot; I/J/K choose the active anatomical slice,
+// Page Up/Down move it a voxel (shift: ten); dropped files are opened
+// (.nii/.nii.gz as the anatomical image). A left click
 // (press and release within kClickSlopPx) picks the fiber under it,
 // ctrl + click adds it to (or removes it from) the selection. ImGui gets the
 // mouse and keyboard first when it wants them (a drag that starts on a

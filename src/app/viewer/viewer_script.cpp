@@ -137,13 +137,17 @@ std::variant<ViewerAction, WaitFrames, WaitLoaded> parseCommand(const std::vecto
       throw Error("resize: expected 16 to 16384 pixels each, got " + std::string(w[1]) + " x " + std::string(w[2]));
     return ViewerAction{ResizeAction{uint32_t(width), uint32_t(height)}};
   }
+  if (name == "anatomy") {
+    expectArguments(w, 1, 1, "anatomy FILE.nii[.gz]");
+    return ViewerAction{AnatomyAction{std::string(w[1])}};
+  }
   if (name == "quit") {
     expectArguments(w, 0, 0, "quit");
     return ViewerAction{QuitAction{}};
   }
   throw Error("unknown command '" + std::string(name) +
               "' (expected orbit, pan, dolly, view, fov, set, wait, wait-loaded, open, model, screenshot, "
-              "pick, clear-selection, export-selection, expect-selected, resize or quit)");
+              "pick, clear-selection, export-selection, expect-selected, resize, anatomy or quit)");
 }
 
 }  // namespace

@@ -16,6 +16,7 @@
 //   export-selection OUT.tck    (the selected fibers of one model: ViewerSelection::exportTck)
 //   expect-selected N           (the run fails naming the line unless N are selected)
 //   resize W H                 (the window, or the offscreen image, in pixels)
+//   anatomy FILE.nii[.gz]       (the anatomical image shown as slices; viewer_anatomy.h)
 //   quit
 #pragma once
 

@@ -70,6 +70,17 @@ struct SelectionInfo {
   std::string export_path = "selection.tck";
 };
 
+// The anatomical volume shown as slices (viewer_anatomy.h fills it), for
+// the anatomy panel (viewer_ui_anatomy.cpp) and the slice keys.
+struct AnatomyInfo {
+  std::string path;  // empty: none loaded
+  int dims[3] = {0, 0, 0};
+  double voxel_mm[3] = {0, 0, 0};
+  float min = 0, max = 0;                // of its finite values
+  float robust_min = 0, robust_max = 1;  // the default display range
+  bool loaded() const { return !path.empty(); }
+};
+
 struct ViewerState {
   RenderSettings settings;
   double fov_deg = 30;
@@ -90,6 +101,8 @@ struct ViewerState {
   std::vector<LoadFailure> load_failures;
   std::vector<std::string> recent_files;  // newest first (recent_files.h)
   SelectionInfo selection;
+  AnatomyInfo anatomy;
+  std::string anatomy_path;  // the anatomy panel's path entry
   // Every visible model is drawn; with a baseline pipeline (lines,
   // raw-compute: one tractogram) only the active one, which the status of
   // the settings panel then says.
@@ -112,6 +125,7 @@ struct ViewerState {
   bool show_performance = true;
   bool show_models = true;
   bool show_selection = true;
+  bool show_anatomy = true;
   std::string screenshot_path = "fibscope.png";  // the screenshot button's file
   std::string open_path;                         // the models panel's path entry
   int screenshot_width = 0, screenshot_height = 0;  // 0: the window as shown
