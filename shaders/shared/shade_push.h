@@ -81,6 +81,7 @@ struct TileClassifyPush {
 // Multi-scale (scales > 1): the same at radius_px * 2^k for k = 0 ..
 // scales - 1 (each scale's spiral turned by a further golden angle), and
 // ao = the product of the per-scale factors, so more scales never lighten.
+// Anatomical slices (fiber kNoFiberObject) take none (1) and cast none.
 struct SsaoPush {
   uint64_t camera;   // CameraBlock: depth_range linearises the clip depth
   uint64_t gbuffer;  // GBufferTexel per pixel

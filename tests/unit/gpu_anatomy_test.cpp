@@ -385,9 +385,15 @@ TEST_F(GpuAnatomySlices, slicesAndFibersHideEachOtherBothWaysAndATranslucentSlic
   FrameRenderer renderer(context(), kWidth, kHeight);
   const int grey = greyOf(600, 0, 1000);  // 153
 
-  for (const RenderPipeline pipeline : {RenderPipeline::Compute, RenderPipeline::RawCompute, RenderPipeline::Lines}) {
-    SCOPED_TRACE(std::string(renderPipelineName(pipeline)));
+  // Every pipeline; and with SSAO, which a slice casts on no fiber behind it.
+  const std::pair<RenderPipeline, bool> variants[] = {{RenderPipeline::Compute, false},
+                                                      {RenderPipeline::RawCompute, false},
+                                                      {RenderPipeline::Lines, false},
+                                                      {RenderPipeline::Compute, true}};
+  for (const auto& [pipeline, ssao] : variants) {
+    SCOPED_TRACE(std::string(renderPipelineName(pipeline)) + (ssao ? " ssao" : ""));
     RenderSettings settings = sliceSettings(2, glm::dvec3(0, 0, 1), SliceSampling::Nearest, 0, 1000);
+    settings.ssao = ssao;
     settings.background = {0, 0, 0};
     settings.pipeline = pipeline;
     settings.line_width_px = 2;
