@@ -178,6 +178,61 @@ bool sphereOccluded(CameraBlock cam, vec3 c, float r) {
   return farthest < nearest - kCullDepthSlack;
 }
 
+layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer CutTilesRef { CutTile tiles[]; };
+
+// A mesh cut discards every fragment the fiblet could draw: its sphere's
+// screen rectangle (sphereOccluded's cube corners, with the line's margin)
+// rounded out to tiles, whose summaries already include their neighbours
+// (shared/cut_mesh.h). "Cull inside": every tile fully covered and the
+// sphere's depths within [max_front, min_back] of all of them; "cull
+// outside": no tile covered at all. A cube reaching past the near plane is
+// never cut.
+bool sphereMeshCut(CameraBlock cam, vec3 c, float r) {
+  const CutMeshFrame cuts = cam.mesh_cuts;
+  if (cuts.mesh_count == 0u) return false;
+  const vec4 centre = cameraTransformPoint(cam.view_projection, c);
+  vec4 axes[3];
+  for (int i = 0; i < 3; ++i) {
+    const vec3 e = vec3(cam.view[0][i], cam.view[1][i], cam.view[2][i]);
+    axes[i] = r * (cam.view_projection[0] * e.x + cam.view_projection[1] * e.y + cam.view_projection[2] * e.z);
+  }
+  vec2 lo = vec2(1e30), hi = vec2(-1e30);
+  float nearest = 1e30, farthest = -1e30;
+  for (int k = 0; k < 8; ++k) {
+    const vec4 q = centre + ((k & 1) != 0 ? axes[0] : -axes[0]) + ((k & 2) != 0 ? axes[1] : -axes[1]) +
+                   ((k & 4) != 0 ? axes[2] : -axes[2]);
+    if (!(q.z > 0.0) || !(q.w > 0.0)) return false;
+    const vec3 ndc = q.xyz / q.w;
+    lo = min(lo, ndc.xy);
+    hi = max(hi, ndc.xy);
+    nearest = min(nearest, ndc.z);
+    farthest = max(farthest, ndc.z);
+  }
+  const vec2 size = cam.viewport.xy;
+  const float margin = 0.5 * cam.viewport.z + kCullPixelSlack;
+  const vec2 first = clamp(floor((lo + 1.0) * 0.5 * size - margin), vec2(0.0), size - 1.0);
+  const vec2 last = clamp(ceil((hi + 1.0) * 0.5 * size + margin), vec2(0.0), size - 1.0);
+  const uvec2 t0 = uvec2(first) / kCutTileSize, t1 = uvec2(last) / kCutTileSize;
+  if ((t1.x - t0.x + 1u) * (t1.y - t0.y + 1u) > 64u) return false;  // large on screen: not worth the loop
+  CutTilesRef tiles = CutTilesRef(cuts.tiles);
+  const uint per_mesh = cuts.tiles_x * cuts.tiles_y;
+  for (uint m = 0u; m < cuts.mesh_count; ++m) {
+    const bool cull_inside = ((cuts.inside_bits >> m) & 1u) != 0u;
+    bool cut = true;
+    for (uint ty = t0.y; ty <= t1.y && cut; ++ty)
+      for (uint tx = t0.x; tx <= t1.x && cut; ++tx) {
+        const CutTile t = tiles.tiles[m * per_mesh + ty * cuts.tiles_x + tx];
+        if (cull_inside)
+          cut = (t.flags & kCutTileAllCovered) != 0u && t.max_front <= nearest - kCullDepthSlack &&
+                t.min_back >= farthest + kCullDepthSlack;
+        else
+          cut = (t.flags & kCutTileAnyCovered) == 0u;
+      }
+    if (cut) return true;
+  }
+  return false;
+}
+
 // The fiber filter kept the fiblet's fiber (or there is no filter). A
 // dropped fiber's fiblets are never drawn, so in phase 2 their visible
 // bits stay clear and the pyramid holds only kept fibers' depths: culling
@@ -206,7 +261,7 @@ void main() {
   float r;
   if (fiblet < ds.fiblet_count && fibletKept(ds, fiblet) && fibletSphere(ds, fiblet, c, r)) {
     const CameraBlock cam = CameraRef(pc.camera).camera;
-    if (sphereClipped(cam, c, r)) {
+    if (sphereClipped(cam, c, r) || sphereMeshCut(cam, c, r)) {
       // (culled in every mode: nothing of it would be drawn)
     } else if (pc.mode == kCullKeptOnly) {
       target = 0;

@@ -28,6 +28,12 @@ void main() {
   kept = kept && (h.x & pc.include_lo) == pc.include_lo && (h.y & pc.include_hi) == pc.include_hi;
   kept = kept && (h.x & pc.exclude_lo) == 0u && (h.y & pc.exclude_hi) == 0u;
   kept = kept && (pc.ordered_regions == 0u || h.z == kFilterOrderKept);
+  if (pc.has_zone != 0u) {
+    const float d2 = uintBitsToFloat(FilterZoneRef(pc.zone_d2).words[fiber]);
+    kept = kept && d2 <= pc.max_d2;
+    // The distance in mm for colouring (a sphere's from its surface, 0 inside).
+    FilterZoneMmRef(pc.zone_mm).values[fiber] = max(sqrt(d2) - pc.zone_radius, 0.0);
+  }
   if (!kept) return;
   const uint g = pc.fiber_base + fiber;
   atomicOr(KeptRef(pc.kept).words[g >> 5u], 1u << (g & 31u));

@@ -41,6 +41,13 @@ void main() {
     }
     h.z = state.y != 0u && state.x == m ? kFilterOrderKept : 0u;
     h.w = 1u;
+    if (pc.has_zone != 0u) {
+      // Every point's distance, ends_only or not.
+      const FilterRegion zone = regions.regions[o + m];
+      float d2 = 1.0 / 0.0;
+      for (uint64_t i = 0ul; i < n; ++i) d2 = min(d2, filterZoneDistance2(zone, rawChunkPoint(c, first - c.first_point + i)));
+      FilterZoneRef(pc.zone_d2).words[s] = floatBitsToUint(d2);
+    }
   }
   FilterHitsRef(pc.hits).hits[s] = h;
 }

@@ -1,8 +1,16 @@
 // Lines baseline: writes the G-buffer texel's four words (shared/gbuffer.h)
 // into an R32G32B32A32_UINT attachment; the depth attachment (LESS) keeps
 // the nearest fragment, and the pass copies the attachment into the
-// G-buffer storage buffer.
+// G-buffer storage buffer. A mesh cut (shared/cut_mesh.h) discards the
+// fragments it hides, by the same per-pixel rule as the compute rasters.
 #version 460
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_buffer_reference : require
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+
+#include "glsl/raw_tractogram.glsl"
+
+layout(push_constant, std430) uniform Push { LinesPush pc; };
 
 layout(location = 0) flat in uint in_fiber;
 layout(location = 1) flat in uint in_segment;
@@ -10,4 +18,18 @@ layout(location = 2) flat in uint in_tangent;
 
 layout(location = 0) out uvec4 texel;
 
-void main() { texel = uvec4(floatBitsToUint(gl_FragCoord.z), in_fiber, in_segment, in_tangent); }
+void main() {
+  const CutMeshFrame cuts = CameraRef(pc.camera).camera.mesh_cuts;
+  if (cuts.mesh_count != 0u) {
+    const CameraBlock cam = CameraRef(pc.camera).camera;
+    const uint width = uint(cam.viewport.x), pixels = width * uint(cam.viewport.y);
+    const uint index = uint(gl_FragCoord.y) * width + uint(gl_FragCoord.x);
+    UintsRef words = UintsRef(cuts.depths);
+    for (uint m = 0u; m < cuts.mesh_count; ++m) {
+      const bool inside = cutInside(words.values[2u * m * pixels + index], words.values[(2u * m + 1u) * pixels + index],
+                                    gl_FragCoord.z);
+      if (inside == (((cuts.inside_bits >> m) & 1u) != 0u)) discard;
+    }
+  }
+  texel = uvec4(floatBitsToUint(gl_FragCoord.z), in_fiber, in_segment, in_tangent);
+}

@@ -9,6 +9,8 @@
 layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer FilterRegionsRef { FilterRegion regions[]; };
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer FilterHitsRef { uvec4 hits[]; };
 layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer FilterMaskRef { uint words[]; };
+layout(buffer_reference, std430, buffer_reference_align = 4) buffer FilterZoneRef { uint words[]; };
+layout(buffer_reference, std430, buffer_reference_align = 4) writeonly buffer FilterZoneMmRef { float values[]; };
 
 // kFilterMask: the voxel p falls in by MRtrix3 tckedit's rule
 // (shared/voxel_mask.h, as the CPU's VoxelMask::contains); outside the
@@ -55,6 +57,13 @@ uvec2 filterOrderedStep(FilterRegionsRef regions, uint first, uint count, vec3 p
       break;
     }
   return state;
+}
+
+// The squared distance of p to the zone (FilterPassPush: the region after
+// the hit and ordered ones).
+float filterZoneDistance2(FilterRegion z, vec3 p) {
+  return filterDistance2(z.kind, z.v[0], z.v[1], z.v[2], z.v[3], z.v[4], z.v[5], vec3(z.v[6], z.v[7], z.v[8]),
+                         vec3(z.v[9], z.v[10], z.v[11]), vec3(z.v[12], z.v[13], z.v[14]), p);
 }
 
 // Whether the sphere (c, r) reaches the box of any of `count` regions from

@@ -35,8 +35,18 @@ bool pixelCovered(int px, int py, vec3 a, vec3 ab, float length2, float radius2)
 // Covers pixel (px, py) with the segment a -> b (window x, y and depth)
 // when its centre lies within `radius` of it (step 5), nearest key wins
 // (steps 6, 7).
+// The mesh cuts (shared/cut_mesh.h) keep a fragment at this pixel and depth.
+bool cutMeshesKeep(CutMeshFrame cuts, uint pixels, uint index, float depth) {
+  UintsRef words = UintsRef(cuts.depths);
+  for (uint m = 0u; m < cuts.mesh_count; ++m) {
+    const bool inside = cutInside(words.values[2u * m * pixels + index], words.values[(2u * m + 1u) * pixels + index], depth);
+    if (inside == (((cuts.inside_bits >> m) & 1u) != 0u)) return false;
+  }
+  return true;
+}
+
 void rasterPixel(VisibilityRef vis, uint width, int px, int py, vec3 a, vec3 ab, float length2, float radius2,
-                 uint64_t payload) {
+                 uint64_t payload, CutMeshFrame cuts, uint pixels) {
   const vec2 c = vec2(float(px) + 0.5, float(py) + 0.5);
   float t = 0.0;
   if (length2 > 0.0) t = clamp(dot(c - a.xy, ab.xy) / length2, 0.0, 1.0);
@@ -50,6 +60,8 @@ void rasterPixel(VisibilityRef vis, uint width, int px, int py, vec3 a, vec3 ab,
   // decrease, so a stale load can only let an atomic through, never skip a
   // needed one.
   const uint index = visibilityIndex(uint(px), uint(py), width);
+  // A mesh cut discards the fragment (the pixel's own depth range, exact).
+  if (cuts.mesh_count != 0u && !cutMeshesKeep(cuts, pixels, uint(py) * width + uint(px), depth)) return;
   const uint64_t key = visibilityKey(depth, payload);
   if (key < vis.keys[index]) atomicMin(vis.keys[index], key);
 }
@@ -112,7 +124,8 @@ void rasterClipSegment(VisibilityRef vis, CameraBlock cam, vec4 c0, vec4 c1, uin
     while (covered != 0u) {
       const int j = findLSB(covered);
       covered &= covered - 1u;
-      rasterPixel(vis, width, x0 + (j & 1), y0 + (j >> 1), a, ab, length2, radius2, payload);
+      rasterPixel(vis, width, x0 + (j & 1), y0 + (j >> 1), a, ab, length2, radius2, payload, cam.mesh_cuts,
+                  width * height);
     }
     return;
   }
@@ -144,7 +157,7 @@ void rasterClipSegment(VisibilityRef vis, CameraBlock cam, vec4 c0, vec4 c1, uin
     for (float n = n_lo; n <= n_hi; n += 1.0) {
       const int px = x_major ? int(m) : int(n);
       const int py = x_major ? int(n) : int(m);
-      rasterPixel(vis, width, px, py, a, ab, length2, radius2, payload);
+      rasterPixel(vis, width, px, py, a, ab, length2, radius2, payload, cam.mesh_cuts, width * height);
     }
   }
 }

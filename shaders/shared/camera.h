@@ -1,6 +1,6 @@
-// The camera block shared by the C++ renderer and the shaders (a uniform or
-// storage block; std140 and std430 lay it out identically because every
-// member is a vec4 or an array of vec4).
+// The camera block shared by the C++ renderer and the shaders (a storage
+// block read through a buffer reference, std430: vec4s and arrays of vec4,
+// then the mesh cuts' addresses).
 //
 // Conventions (Vulkan; src/render/camera.h builds the matrices, the CPU
 // reference rasteriser src/render/reference_raster.h follows them exactly):
@@ -24,6 +24,11 @@
 #define FIBSCOPE_SHADERS_SHARED_CAMERA_H
 
 #include "shared/glsl_cpp.h"
+#include "shared/cut_mesh.h"
+
+#ifdef __cplusplus
+#include <cstddef>
+#endif
 
 SHADER_NAMESPACE_BEGIN
 
@@ -52,6 +57,9 @@ struct CameraBlock {
   vec4 clip_world[kMaxFrameClipPlanes];
   vec4 clip_space[kMaxFrameClipPlanes];
   vec4 cuts;  // x: clip planes in use (a count, 0 .. kMaxFrameClipPlanes); y, z, w: 0
+  // The mesh cuts' depth buffers and tiles (shared/cut_mesh.h); mesh_count
+  // 0: none. Written by the mesh-cut stage after the setup stage.
+  CutMeshFrame mesh_cuts;
 };
 
 // Column-major 4x4 times (p, 1), summed column by column in a fixed order.
@@ -66,7 +74,8 @@ SHADER_FN vec4 cameraTransformPoint(vec4 m[4], vec3 p) {
 SHADER_NAMESPACE_END
 
 #ifdef __cplusplus
-static_assert(sizeof(fibscope::shader::CameraBlock) == 448, "camera block: 28 vec4, no padding");
+static_assert(sizeof(fibscope::shader::CameraBlock) == 480, "camera block: 28 vec4 and the mesh cuts, no padding");
+static_assert(offsetof(fibscope::shader::CameraBlock, mesh_cuts) == 448, "");
 #endif
 
 #endif  // FIBSCOPE_SHADERS_SHARED_CAMERA_H

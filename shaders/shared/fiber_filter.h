@@ -89,7 +89,17 @@ struct FilterPassPush {
   uint ends_only;        // 1: only the first and the last vertex of a fiber count
   float min_length;      // the limits with tckedit's margin (FiberFilter::lengthRange)
   float max_length;
+  // Distance to a zone: the zone is regions[hit_regions + ordered_regions]
+  // when has_zone; per fiber the smallest squared distance (float bits,
+  // atomicMin) in `zone_d2`, the distance in mm in `zone_mm` (combine), and
+  // kept only within max_d2 (+inf: no threshold).
+  uint has_zone;
+  float max_d2;
+  float zone_radius;  // a sphere zone's radius (its distances are |p - c| - r)
   uint pad0;
+  uint pad1;
+  uint64_t zone_d2;
+  uint64_t zone_mm;
 };
 
 // The region tests, the same arithmetic on both sides (glsl_cpp.h's rules:
@@ -124,12 +134,52 @@ SHADER_FN bool filterOrientedBoxContains(vec3 c, vec3 half_size, vec3 a0, vec3 a
          filterAxisWithin(d, a2.x, a2.y, a2.z, half_size.z);
 }
 
+// Distance to a zone (the fiblets paper's figure 11 e, f): the squared
+// distance from p to the zone's core, without a square root (whose GPU
+// precision is the implementation's), so a threshold decides alike on both
+// sides: a point or a sphere's centre (a sphere's distance is then
+// |p - c| - r, its threshold (t + r)^2), a box's or an oriented box's
+// volume (0 inside).
+SHADER_FN float filterClampedOut(float lo, float hi, float x) {
+  SHADER_PRECISE float below = lo - x;
+  SHADER_PRECISE float above = x - hi;
+  return below > 0.0f ? below : (above > 0.0f ? above : 0.0f);
+}
+SHADER_FN float filterDistance2(uint kind, float v0, float v1, float v2, float v3, float v4, float v5, vec3 a0, vec3 a1,
+                                vec3 a2, vec3 p) {
+  if (kind == kFilterSphere) {
+    SHADER_PRECISE float dx = p.x - v0;
+    SHADER_PRECISE float dy = p.y - v1;
+    SHADER_PRECISE float dz = p.z - v2;
+    SHADER_PRECISE float d2 = (dx * dx + dy * dy) + dz * dz;
+    return d2;
+  }
+  if (kind == kFilterBox) {
+    SHADER_PRECISE float dx = filterClampedOut(v0, v3, p.x);
+    SHADER_PRECISE float dy = filterClampedOut(v1, v4, p.y);
+    SHADER_PRECISE float dz = filterClampedOut(v2, v5, p.z);
+    SHADER_PRECISE float d2 = (dx * dx + dy * dy) + dz * dz;
+    return d2;
+  }
+  // Oriented box: centre v0..2, half sizes v3..5, axes a0..a2.
+  SHADER_PRECISE vec3 d = vec3(p.x - v0, p.y - v1, p.z - v2);
+  SHADER_PRECISE float s0 = (d.x * a0.x + d.y * a0.y) + d.z * a0.z;
+  SHADER_PRECISE float s1 = (d.x * a1.x + d.y * a1.y) + d.z * a1.z;
+  SHADER_PRECISE float s2 = (d.x * a2.x + d.y * a2.y) + d.z * a2.z;
+  SHADER_PRECISE float q0 = filterClampedOut(-v3, v3, s0);
+  SHADER_PRECISE float q1 = filterClampedOut(-v4, v4, s1);
+  SHADER_PRECISE float q2 = filterClampedOut(-v5, v5, s2);
+  SHADER_PRECISE float d2 = (q0 * q0 + q1 * q1) + q2 * q2;
+  return d2;
+}
+
 SHADER_NAMESPACE_END
 
 #ifdef __cplusplus
 static_assert(sizeof(fibscope::shader::FilterRegion) == 128, "a filter region is 128 bytes in std430");
 static_assert(offsetof(fibscope::shader::FilterRegion, v) == 32, "the floats follow the header");
-static_assert(sizeof(fibscope::shader::FilterPassPush) == 96, "");
+static_assert(sizeof(fibscope::shader::FilterPassPush) == 128, "");
+static_assert(offsetof(fibscope::shader::FilterPassPush, zone_d2) == 112, "");
 #endif
 
 #endif  // FIBSCOPE_SHADERS_SHARED_FIBER_FILTER_H

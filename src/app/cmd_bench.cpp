@@ -22,6 +22,7 @@
 #include "app/commands.h"
 #include "app/render_options.h"
 #include "app/render_scene.h"
+#include "app/scene_cuts.h"
 #include "app/scene_filter.h"
 #include "core/error.h"
 #include "render/camera.h"
@@ -120,6 +121,8 @@ void runBench(const BenchOptions& o) {
   // The criteria, evaluated once: each variant's frames read the kept bits
   // of its pipeline's input.
   const SceneFilter filter(*context, scene, criteria, o.render.dim_dropped);
+  const SceneCuts cuts(*context, o.render);
+  cuts.apply(gpu_scene);
   std::vector<GpuScene> variant_scenes(variants.size(), gpu_scene);
   for (size_t i = 0; i < variants.size(); ++i) filter.apply(variant_scenes[i], variants[i].settings.pipeline);
 

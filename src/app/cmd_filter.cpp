@@ -64,6 +64,8 @@ void runFilterCommand(const FilterOptions& o) {
   for (size_t i = 0; i < r.by_exclude.size(); ++i) dropped("entered " + named.exclude_names[i], r.by_exclude[i]);
   for (size_t i = 0; i < r.by_include.size(); ++i) dropped("missed " + named.include_names[i], r.by_include[i]);
   if (!criteria.include_ordered.empty()) dropped("missed the --include-ordered regions or their order", r.by_order);
+  if (criteria.distance_zone && !std::isnan(criteria.max_distance_mm))
+    dropped("farther than --max-distance from --distance-to", r.by_distance);
 }
 
 }  // namespace

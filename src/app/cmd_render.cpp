@@ -15,6 +15,7 @@
 #include "app/commands.h"
 #include "app/render_options.h"
 #include "app/render_scene.h"
+#include "app/scene_cuts.h"
 #include "app/scene_filter.h"
 #include "core/error.h"
 #include "io/png_writer.h"
@@ -101,6 +102,10 @@ void runRender(const RenderCommandOptions& o) {
   applyScalarColoring(context, scene.fiblets, o.render, settings, gpu_scene);
   const SceneFilter filter(context, scene, criteria, o.render.dim_dropped);
   filter.apply(gpu_scene, settings.pipeline);
+  if (settings.color == ColorMode::Scalar && !o.render.gave("scalar-range"))
+    filter.distanceRange(settings.scalar_min, settings.scalar_max);  // colour by distance: its range
+  const SceneCuts cuts(context, o.render);
+  cuts.apply(gpu_scene);
   GpuAnatomy anatomy;
   if (volume) {
     RenderSettings* fitted[] = {&settings};

@@ -1,14 +1,18 @@
 // `fibscope view [FILE...] [--size WxH] [--screenshot OUT.png --frames N]
 // [--script FILE] [--offscreen] [--no-vsync] [--orbit DEG] [--validate] [--device NAME]
-// [--phantom-streamlines N] [render settings]`: the interactive viewer
+// [--phantom-streamlines N] [render settings] [filter criteria: --include ... --roi-set]`:
+// the interactive viewer
 // (src/app/viewer/). Without a display it renders offscreen, so scripts and
 // tests run anywhere Vulkan does.
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "app/commands.h"
+#include "app/criteria_options.h"
+#include "app/viewer/dissection.h"
 #include "app/render_options.h"
 #include "app/viewer/viewer_app.h"
 #include "core/error.h"
@@ -28,8 +32,34 @@ struct ViewCommandOptions {
   double orbit_deg = 0;
 };
 
+// The dissection the viewer starts with: the --roi-set's (its planes and
+// slab are in the settings already: renderSettingsFrom), then the command
+// line's regions as ROIs, its ends-only and length limits winning.
+RoiSet startingDissection(const CriteriaCliOptions& o) {
+  criteriaFrom(o);  // bad specs, lengths or files: one line before any window
+  RoiSet set;
+  if (!o.roi_set.empty()) {
+    set = loadRoiSet(o.roi_set);
+    set.clip_planes.clear();
+    set.slab.reset();
+  }
+  auto add = [&](const std::vector<std::string>& specs, RoiRole role, const char* name) {
+    for (const std::string& spec : specs)
+      set.rois.push_back(Roi{uniqueRoiName(set, name), parseRegion(spec), role, true});
+  };
+  add(o.include, RoiRole::Include, "include");
+  add(o.exclude, RoiRole::Exclude, "exclude");
+  add(o.include_ordered, RoiRole::IncludeOrdered, "ordered");
+  set.ends_only = set.ends_only || o.ends_only;
+  if (!std::isnan(o.min_length)) set.min_length_mm = o.min_length;
+  if (!std::isnan(o.max_length)) set.max_length_mm = o.max_length;
+  return set;
+}
+
 void runView(ViewCommandOptions o) {
   ViewerOptions v;
+  v.dissection = startingDissection(o.render.criteria);
+  v.dim_dropped = o.render.dim_dropped;
   v.files = o.files;
   v.phantom_streamlines = o.render.phantom_streamlines;
   parseFrameSize(o.render.size, v.width, v.height);

@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 
 #include "core/error.h"
+#include "select/number_list.h"
 #include "select/roi_set.h"
 
 namespace fibscope {
@@ -33,6 +34,10 @@ void addCriteriaCliOptions(CLI::App* cmd, CriteriaCliOptions& o) {
   cmd->add_flag("--ends-only", o.ends_only, "Test only the two end vertices against the regions");
   cmd->add_option("--min-length", o.min_length, "Shortest length kept, mm");
   cmd->add_option("--max-length", o.max_length, "Longest length kept, mm");
+  cmd->add_option("--distance-to", o.distance_to,
+                  "A zone: X,Y,Z (a point) or a sphere:, box: or obox: spec; each fiber's smallest distance to it "
+                  "(mm, from any vertex) is measured: a threshold with --max-distance, a colour with --color scalar");
+  cmd->add_option("--max-distance", o.max_distance, "Keep the fibers within this distance of --distance-to, mm");
   cmd->add_option("--roi-set", o.roi_set,
                   "A ROI set (JSON, as the viewer saves it): its enabled regions, ends-only flag and length limits "
                   "join the options here (whose regions come after its; whose length limits win)");
@@ -50,6 +55,26 @@ CliCriteria criteriaFrom(const CriteriaCliOptions& o) {
       throw Error(std::string(name) + ": expected a length >= 0 mm");
   criteria.min_length_mm = o.min_length;
   criteria.max_length_mm = o.max_length;
+  if (!o.distance_to.empty()) {
+    std::vector<double> v;
+    if (parseNumberList(o.distance_to, v) && v.size() == 3) {
+      criteria.distance_zone = SphereRegion{{float(v[0]), float(v[1]), float(v[2])}, 0.0f};  // a point
+    } else {
+      try {
+        criteria.distance_zone = parseRegion(o.distance_to);
+      } catch (const Error& e) {
+        throw Error(std::string("--distance-to ") + e.what());
+      }
+      if (std::holds_alternative<MaskRegion>(*criteria.distance_zone))
+        throw Error("--distance-to " + o.distance_to + ": expected a point, a sphere, a box or an oriented box");
+    }
+  }
+  if (!std::isnan(o.max_distance)) {
+    if (!(o.max_distance >= 0 && std::isfinite(o.max_distance)))
+      throw Error("--max-distance: expected a distance >= 0 mm");
+    if (!criteria.distance_zone) throw Error("--max-distance: needs --distance-to");
+    criteria.max_distance_mm = o.max_distance;
+  }
   if (!o.roi_set.empty()) {
     const RoiSet set = loadRoiSet(o.roi_set);
     criteria = mergeCriteria(filterCriteria(set), criteria);

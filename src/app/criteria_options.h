@@ -23,6 +23,9 @@ struct CriteriaCliOptions {
   bool ends_only = false;
   double min_length = NAN, max_length = NAN;
   std::string roi_set;
+  // --distance-to X,Y,Z (a point) or a sphere/box/obox spec, --max-distance MM.
+  std::string distance_to;
+  double max_distance = NAN;
 };
 
 // The criteria, and a name for each include and exclude region (in the

@@ -52,6 +52,9 @@ void addRenderCliOptions(CLI::App* cmd, RenderCliOptions& o) {
   cmd->add_option("--clip-plane", o.clip_planes,
                   "Draw only the side of the plane through PX,PY,PZ that the normal NX,NY,NZ points to (mm); "
                   "fibers are clipped at the plane; repeatable, at most 6");
+  cmd->add_option("--cut-mesh", o.cut_meshes,
+                  "Hide what lies inside (SPEC:inside) or outside (SPEC:outside) a closed mesh, per pixel: SPEC is "
+                  "an OBJ file or box:X0,Y0,Z0,X1,Y1,Z1, obox:... or sphere:X,Y,Z,R; repeatable, at most 4");
   cmd->add_option("--anatomy", o.anatomy,
                   "NIfTI volume (.nii, .nii.gz: T1, FA, ...) shown as its three voxel-plane slices (--slice-i/j/k, "
                   "--anatomy-range, --anatomy-opacity)");

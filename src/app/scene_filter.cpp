@@ -1,11 +1,14 @@
 #include "app/scene_filter.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace fibscope {
 
 SceneFilter::SceneFilter(const gpu::VulkanContext& context, const LoadedScene& scene, const FilterCriteria& criteria,
                          bool dim)
     : dim_(dim) {
-  if (criteria.empty()) return;
+  if (criteria.empty() && !criteria.distance_zone) return;
   const FiberFilter filter(criteria, scene.step_size_mm);
   const shader::FibletDataset& block = scene.fiblets.block();
   const FilterFibletSource source{scene.fiblets.blockAddress(), block.fiblet_count, block.fiber_count, 0,
@@ -25,6 +28,7 @@ SceneFilter::SceneFilter(const gpu::VulkanContext& context, const LoadedScene& s
 void SceneFilter::apply(GpuScene& scene, RenderPipeline pipeline) const {
   if (!active()) return;
   const GpuFiberFilter& f = pipeline == RenderPipeline::Compute || !raw_ ? *fiblets_ : *raw_;
+  if (f.zoneDistances() != 0) scene.fiber_scalars = f.zoneDistances();
   if (dim_) {
     // Kept fibers as the selection: the rest dimmed. (Nothing kept: an
     // empty selection would dim nothing, so the words are passed anyway.)
@@ -33,6 +37,18 @@ void SceneFilter::apply(GpuScene& scene, RenderPipeline pipeline) const {
   }
   scene.kept_bits = f.keptBits();
   scene.kept_point_bits = f.keptPointBits();
+}
+
+bool SceneFilter::distanceRange(float& lo, float& hi) const {
+  if (!fiblets_ || fiblets_->zoneDistances() == 0) return false;
+  bool any = false;
+  for (float d : fiblets_->zoneDistanceValues()) {
+    if (!std::isfinite(d)) continue;
+    lo = any ? std::min(lo, d) : d;
+    hi = any ? std::max(hi, d) : d;
+    any = true;
+  }
+  return any;
 }
 
 }  // namespace fibscope

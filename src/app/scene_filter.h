@@ -25,8 +25,13 @@ class SceneFilter {
 
   bool active() const { return fiblets_ != nullptr; }
   // Sets what a frame of `pipeline` reads: scene.kept_bits (and
-  // kept_point_bits) when hiding, scene.selection_bits when dimming.
+  // kept_point_bits) when hiding, scene.selection_bits when dimming; with
+  // a distance zone, scene.fiber_scalars = each fiber's distance to it (mm),
+  // what ColorMode::Scalar then shows.
   void apply(GpuScene& scene, RenderPipeline pipeline) const;
+  // With a distance zone: the smallest and largest finite distance (for
+  // the colormap's range); false without one.
+  bool distanceRange(float& lo, float& hi) const;
   uint64_t kept() const { return fiblets_ ? fiblets_->keptCount() : 0; }
   uint64_t fibers() const { return fiblets_ ? fiblets_->fiberCount() : 0; }
   double gpuMilliseconds() const { return gpu_ms_; }

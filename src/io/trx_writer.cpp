@@ -123,6 +123,7 @@ class TrxWriter final : public TractogramWriter {
   TrxWriter(const std::string& path, const TractogramHeader& like, const WriterOptions& options);
   void write(const Tractogram& chunk) override;
   void finish() override;
+  void setGroups(std::vector<Group> groups) override;
 
  private:
   std::unique_ptr<OutputFile> createMember(const std::string& member);
@@ -263,6 +264,13 @@ void TrxWriter::write(const Tractogram& chunk) {
   for (size_t a = 0; a < per_point_.size(); ++a) appendValues(per_point_[a], chunk.per_point[a].values);
   streamlines_ += n;
   points_ += chunk.pointCount();
+}
+
+void TrxWriter::setGroups(std::vector<Group> groups) {
+  if (finished_) fail(path_, "internal error: setGroups() after finish()");
+  // The data per group of the header's groups goes with them.
+  std::erase_if(like_.properties, [](const auto& kv) { return kv.first.rfind("dpg/", 0) == 0; });
+  like_.groups = std::move(groups);
 }
 
 void TrxWriter::writeGroups() {

@@ -32,6 +32,13 @@ class TractogramWriter {
   virtual void write(const Tractogram& chunk) = 0;
   // Completes and renames the output. Must be called exactly once.
   virtual void finish() = 0;
+  // Groups of the streamlines written (indices in the output), for outputs
+  // whose groups are known only once the streamlines are (a filter's):
+  // they replace the groups of the header the writer was made with. Call
+  // before finish(). Formats without groups (tck, trk) drop them and warn.
+  virtual void setGroups(std::vector<Group> groups) {
+    if (!groups.empty()) warn(std::to_string(groups.size()) + " group(s) not written: the format has no groups");
+  }
   const std::vector<std::string>& warnings() const { return warnings_; }
 
  protected:

@@ -1,5 +1,12 @@
 #include "render/reference_raster.h"
 
+#include <bit>
+#include <glm/glm.hpp>
+#include <glm/gtc/type_ptr.hpp>
+
+#include "select/cut_mesh.h"
+#include "shared/cut_mesh.h"
+
 #include <algorithm>
 #include <cmath>
 #include <glm/glm.hpp>
@@ -60,6 +67,11 @@ void rasterizeWindowSegment(ReferenceFrame& frame, const WindowVertex& a, const 
       if (depth > 1.0) continue;  // beyond the far plane
       const float d = float(depth);
       const size_t i = frame.index(px, py);
+      bool cut = false;
+      for (const ReferenceMeshCut& m : frame.mesh_cuts)
+        cut |= shader::cutInside(std::bit_cast<uint32_t>(m.front[i]), std::bit_cast<uint32_t>(m.back[i]), d) ==
+               m.cull_inside;
+      if (cut) continue;
       ++frame.fragments[i];
       const bool wins = d < frame.depth[i] ||
                         (d == frame.depth[i] && (fiber < frame.fiber[i] ||
@@ -119,13 +131,15 @@ WindowVertex toWindow(const Clip& c, uint32_t width, uint32_t height) {
 }  // namespace
 
 ReferenceFrame rasterizeReference(const Tractogram& tractogram, const Camera& camera, float line_width_px,
-                                  const std::vector<std::array<double, 4>>& clip_planes) {
+                                  const std::vector<std::array<double, 4>>& clip_planes,
+                                  const std::vector<ReferenceMeshCut>& mesh_cuts) {
   if (!(line_width_px >= kMinLineWidth && line_width_px <= kMaxLineWidth))
     fail("reference raster", "line width must lie in [1, 4] px, got " + std::to_string(line_width_px));
   if (tractogram.streamlineCount() >= kNoFiber)
     fail("reference raster", "more than 2^32 - 2 streamlines");
   const std::array<double, 16> vp = viewProjectionD(camera);  // validates the camera
   ReferenceFrame frame(camera.width, camera.height);
+  frame.mesh_cuts = mesh_cuts;
   for (size_t s = 0; s < tractogram.streamlineCount(); ++s) {
     const size_t first = tractogram.offsets[s], n = tractogram.pointsIn(s);
     if (n > 0xFFFFFFFFu) fail("reference raster", "streamline " + std::to_string(s) + " has more than 2^32 - 1 points");
@@ -154,6 +168,34 @@ ReferenceFrame rasterizeReference(const Tractogram& tractogram, const Camera& ca
     }
   }
   return frame;
+}
+
+ReferenceMeshCut referenceMeshCut(const TriangleMesh& mesh, const Camera& camera, bool cull_inside) {
+  const std::array<double, 16> vp = viewProjectionD(camera);
+  const glm::dmat4 m = glm::make_mat4(vp.data()), inverse = glm::inverse(m);
+  ReferenceMeshCut cut;
+  cut.cull_inside = cull_inside;
+  const size_t pixels = size_t(camera.width) * camera.height;
+  cut.front.assign(pixels, kEmptyDepth);
+  cut.back.assign(pixels, kEmptyDepth);
+  const glm::vec3 eye(camera.eye[0], camera.eye[1], camera.eye[2]);
+  for (uint32_t py = 0; py < camera.height; ++py)
+    for (uint32_t px = 0; px < camera.width; ++px) {
+      const double x = (px + 0.5) / camera.width * 2 - 1, y = (py + 0.5) / camera.height * 2 - 1;
+      glm::dvec4 far_point = inverse * glm::dvec4(x, y, 1, 1);
+      far_point /= far_point.w;
+      const glm::vec3 dir = glm::vec3(glm::dvec3(far_point) - glm::dvec3(eye));
+      const size_t i = size_t(py) * camera.width + px;
+      for (const MeshHit& hit : rayMeshHits(mesh, eye, dir)) {
+        const glm::dvec3 p = glm::dvec3(eye) + double(hit.distance) * glm::normalize(glm::dvec3(dir));
+        const glm::dvec4 c = m * glm::dvec4(p, 1);
+        const double depth = c.z / c.w;
+        if (!(depth >= 0 && depth <= 1)) continue;  // clipped at the near plane or beyond the far one
+        float& slot = hit.front ? cut.front[i] : cut.back[i];
+        slot = std::min(slot, float(depth));
+      }
+    }
+  return cut;
 }
 
 void rasterizeReferenceSpheres(ReferenceFrame& frame, const std::vector<ReferenceSphere>& spheres,

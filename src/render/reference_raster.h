@@ -38,6 +38,7 @@
 #include <vector>
 
 #include "core/tractogram.h"
+#include "io/obj_mesh.h"
 #include "render/camera.h"
 
 namespace fibscope {
@@ -47,8 +48,21 @@ inline constexpr uint32_t kNoFiber = 0xFFFFFFFFu;
 inline constexpr float kMinLineWidth = 1.0f;
 inline constexpr float kMaxLineWidth = 4.0f;
 
+// A mesh cut's per-pixel depth range (shared/cut_mesh.h's rule), from the
+// eye ray through each pixel centre against the mesh's triangles
+// (select/cut_mesh.h rayMeshHits, in float): the nearest entering hit and
+// the nearest leaving one with clip depth in [0, 1] (kEmptyDepth where
+// none). Fragments inside the range are dropped (cull_inside) or those
+// outside it.
+struct ReferenceMeshCut {
+  std::vector<float> front, back;
+  bool cull_inside = true;
+};
+
 struct ReferenceFrame {
   uint32_t width = 0, height = 0;
+  // Mesh cuts applied to every fragment written (set before drawing).
+  std::vector<ReferenceMeshCut> mesh_cuts;
   // Row-major, index = py * width + px, py = 0 the top row.
   std::vector<float> depth;          // clip z/w in [0, 1]; kEmptyDepth where nothing is drawn
   std::vector<uint32_t> fiber;       // kNoFiber where nothing is drawn
@@ -88,7 +102,8 @@ void rasterizeWindowSegment(ReferenceFrame& frame, const WindowVertex& a, const 
 // tangent stays the whole segment's).
 ReferenceFrame rasterizeReference(const Tractogram& tractogram, const Camera& camera,
                                   float line_width_px = 1.0f,
-                                  const std::vector<std::array<double, 4>>& clip_planes = {});
+                                  const std::vector<std::array<double, 4>>& clip_planes = {},
+                                  const std::vector<ReferenceMeshCut>& mesh_cuts = {});
 
 // A sphere drawn with the lines: the CPU reference of the surface passes
 // (shaders/sphere_surface.comp and the merge, shared/surface_push.h).
@@ -107,6 +122,9 @@ struct ReferenceSphere {
 // Throws Error for an invalid camera or a sphere whose radius is not > 0.
 void rasterizeReferenceSpheres(ReferenceFrame& frame, const std::vector<ReferenceSphere>& spheres,
                                const Camera& camera);
+
+// The cut range of `mesh` (closed, outward) seen by `camera`.
+ReferenceMeshCut referenceMeshCut(const TriangleMesh& mesh, const Camera& camera, bool cull_inside);
 
 // Orientation colour: |tangent| as RGB on a black background, alpha 255;
 // row-major RGBA8, top row first.

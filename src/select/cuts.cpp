@@ -7,25 +7,11 @@
 #include <glm/geometric.hpp>
 
 #include "core/error.h"
+#include "select/number_list.h"
 #include "select/cut_mesh.h"
 
 namespace fibscope {
 namespace {
-
-// Comma-separated finite numbers (region.cpp reads its specs the same way).
-bool parseNumbers(std::string_view text, std::vector<double>& out) {
-  out.clear();
-  while (true) {
-    const size_t comma = text.find(',');
-    const std::string_view item = text.substr(0, comma);
-    double v = 0;
-    const auto [end, ec] = std::from_chars(item.data(), item.data() + item.size(), v);
-    if (ec != std::errc() || end != item.data() + item.size() || !std::isfinite(v)) return false;
-    out.push_back(v);
-    if (comma == std::string_view::npos) return true;
-    text.remove_prefix(comma + 1);
-  }
-}
 
 // The shortest text that reads back as the same float.
 std::string number(float v) {
@@ -50,7 +36,7 @@ ClipPlane makeClipPlane(const glm::vec3& point, const glm::vec3& normal, const s
 ClipPlane parseClipPlane(std::string_view spec) {
   const std::string text(spec);
   std::vector<double> v;
-  if (!parseNumbers(spec, v) || v.size() != 6)
+  if (!parseNumberList(spec, v) || v.size() != 6)
     fail(text, "expected a clip plane as PX,PY,PZ,NX,NY,NZ (a point and the normal of the side kept, mm)");
   for (const double x : v)
     if (!std::isfinite(float(x))) fail(text, "a clip plane's values must be finite floats");
@@ -72,7 +58,7 @@ Slab parseSlab(std::string_view spec) {
       fail(text, "a slab follows axial, coronal or sagittal (or nothing: the focal plane), not '" + slab.follow + "'");
   }
   std::vector<double> v;
-  if (!parseNumbers(value, v) || v.size() != 1)
+  if (!parseNumberList(value, v) || v.size() != 1)
     fail(text, "expected a slab as T or T:axial|coronal|sagittal (thickness in mm)");
   if (!(v[0] > 0 && std::isfinite(float(v[0])) && float(v[0]) > 0)) fail(text, "a slab's thickness must be > 0 mm");
   slab.thickness_mm = float(v[0]);

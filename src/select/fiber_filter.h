@@ -20,11 +20,13 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/tractogram.h"
 #include "select/region.h"
+#include "shared/fiber_filter.h"
 
 namespace fibscope {
 
@@ -35,11 +37,20 @@ struct FilterCriteria {
   bool ends_only = false;               // test only the two end vertices (tckedit -ends_only)
   double min_length_mm = NAN;           // NaN: no limit
   double max_length_mm = NAN;
+  // Distance to a zone (the fiblets paper's figure 11 e, f): the smallest
+  // distance from any vertex (every vertex, ends_only or not) to a point
+  // (a sphere of radius 0), a sphere, a box or an oriented box (0 inside);
+  // kept only when it is <= max_distance_mm (NaN: no threshold, the
+  // distance is only measured, e.g. for colouring). Decided on squared
+  // distances in float (shared/fiber_filter.h), alike on the CPU and GPU.
+  std::optional<Region> distance_zone;
+  double max_distance_mm = NAN;
+  // No criterion drops anything (a zone without a threshold drops nothing).
   bool empty() const;
 };
 
 // Why a streamline was dropped (Kept: it was not).
-enum class FilterReason : uint8_t { Kept, Length, Exclude, Include, IncludeOrdered };
+enum class FilterReason : uint8_t { Kept, Length, Exclude, Include, IncludeOrdered, Distance };
 
 struct FilterVerdict {
   FilterReason reason = FilterReason::Kept;
@@ -68,9 +79,27 @@ class FiberFilter {
   // The length limits with the margin (-inf / +inf without a limit).
   float minLength() const { return min_length_; }
   float maxLength() const { return max_length_; }
+  // The zone as the tests run on it, and the squared threshold its
+  // distances are compared with (+inf without one); the zone's smallest
+  // distance from the streamline (mm; +inf for no points, 0 inside).
+  const shader::FilterRegion* zone() const { return has_zone_ ? &zone_ : nullptr; }
+  float maxZoneDistance2() const { return max_zone_d2_; }
+  float zoneDistance(const float* xyz, size_t n) const;
 
  private:
+  // A region in the form the tests run on (select/packed_region.h: the
+  // floats and the box the GPU filter gets too), with its mask.
+  struct Packed {
+    shader::FilterRegion region;
+    const VoxelMask* mask = nullptr;
+  };
   FilterCriteria criteria_;
+  std::vector<Packed> include_, include_ordered_, exclude_;
+  shader::FilterRegion zone_{};
+  bool has_zone_ = false;
+  float max_zone_d2_ = INFINITY;
+  float zoneDistance2(const float* xyz, size_t n) const;
+  FilterVerdict evaluateRegions(const float* xyz, size_t n) const;
   float min_length_ = -INFINITY, max_length_ = INFINITY;  // with the margin
 };
 

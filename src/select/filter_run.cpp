@@ -72,6 +72,7 @@ FilterReport runFilter(TractogramReader& reader, TractogramWriter& writer, const
         case FilterReason::Exclude: ++report.by_exclude[v.region]; break;
         case FilterReason::Include: ++report.by_include[v.region]; break;
         case FilterReason::IncludeOrdered: ++report.by_order; break;
+        case FilterReason::Distance: ++report.by_distance; break;
       }
     }
     report.streamlines += n;

@@ -23,6 +23,7 @@ struct FilterReport {
   std::vector<uint64_t> by_exclude;      // per exclude region: dropped by entering it
   std::vector<uint64_t> by_include;      // per include region: dropped for missing it (the first missed)
   uint64_t by_order = 0;                 // dropped for the ordered includes (missed or out of order)
+  uint64_t by_distance = 0;              // dropped for lying farther than the threshold from the zone
 };
 
 // Filters everything `reader` gives into `writer` (which the caller

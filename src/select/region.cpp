@@ -8,25 +8,11 @@
 #include <vector>
 
 #include "core/error.h"
+#include "select/number_list.h"
 #include "select/packed_region.h"
 
 namespace fibscope {
 namespace {
-
-// Comma-separated finite numbers.
-bool parseNumbers(std::string_view text, std::vector<double>& out) {
-  out.clear();
-  while (true) {
-    const size_t comma = text.find(',');
-    const std::string_view item = text.substr(0, comma);
-    double v = 0;
-    const auto [end, ec] = std::from_chars(item.data(), item.data() + item.size(), v);
-    if (ec != std::errc() || end != item.data() + item.size() || !std::isfinite(v)) return false;
-    out.push_back(v);
-    if (comma == std::string_view::npos) return true;
-    text.remove_prefix(comma + 1);
-  }
-}
 
 std::string number(double v) {
   char buf[32];
@@ -67,7 +53,7 @@ Region parseRegion(std::string_view spec) {
   }
   const std::string_view values = colon == std::string_view::npos ? spec : spec.substr(colon + 1);
   std::vector<double> v;
-  const bool numbers = parseNumbers(values, v);
+  const bool numbers = parseNumberList(values, v);
   if (kind == "sphere") {
     if (!numbers || v.size() != 4)
       fail(text, "expected a sphere as sphere:X,Y,Z,R (mm; or X,Y,Z,R)");

@@ -387,6 +387,9 @@ FilterCriteria mergeCriteria(FilterCriteria set, const FilterCriteria& command_l
   set.ends_only = set.ends_only || command_line.ends_only;
   if (!std::isnan(command_line.min_length_mm)) set.min_length_mm = command_line.min_length_mm;
   if (!std::isnan(command_line.max_length_mm)) set.max_length_mm = command_line.max_length_mm;
+  // (A set holds no distance zone: the command line's is the only one.)
+  set.distance_zone = command_line.distance_zone;
+  set.max_distance_mm = command_line.max_distance_mm;
   return set;
 }
 

@@ -104,6 +104,36 @@ TEST(FiberFilter, includeExcludeEndsOnlyAndLengthAsTckedit) {
   EXPECT_THROW(FiberFilter(FilterCriteria{{}, {}, {}, false, 5, 4}), Error);
 }
 
+TEST(FiberFilter, distanceToAZoneIsTheNearestVertexsAndAThreshold) {
+  // A line along x at y = 0, z = 0, vertices every 1 mm from 0 to 10.
+  const std::vector<float> line = lineX(0, 10);
+  const size_t n = line.size() / 3;
+  FilterCriteria c;
+  c.distance_zone = SphereRegion{{5.5f, 3, 4}, 0};  // a point: nearest vertices x = 5, 6 at sqrt(0.25 + 25)
+  const FiberFilter measure(c);
+  EXPECT_TRUE(measure.evaluate(line.data(), n).kept()) << "no threshold: nothing dropped";
+  EXPECT_NEAR(measure.zoneDistance(line.data(), n), std::sqrt(25.25), 1e-5);
+  c.max_distance_mm = 5.03;
+  EXPECT_TRUE(FiberFilter(c).evaluate(line.data(), n).kept());
+  c.max_distance_mm = 5.02;
+  EXPECT_EQ(FiberFilter(c).evaluate(line.data(), n).reason, FilterReason::Distance);
+  // A sphere: from its surface; a box: 0 inside, else to its faces; every
+  // vertex counts, ends only or not.
+  c.distance_zone = parseRegion("sphere:5,0,7,2");
+  c.max_distance_mm = 5.0;
+  c.ends_only = true;
+  EXPECT_NEAR(FiberFilter(c).zoneDistance(line.data(), n), 5.0, 1e-5);
+  EXPECT_TRUE(FiberFilter(c).evaluate(line.data(), n).kept()) << "a middle vertex is 5 mm from the surface";
+  c.distance_zone = parseRegion("box:3,-1,-1,4,1,1");
+  c.max_distance_mm = 0;
+  EXPECT_EQ(FiberFilter(c).zoneDistance(line.data(), n), 0.0f);
+  EXPECT_TRUE(FiberFilter(c).evaluate(line.data(), n).kept());
+  c.distance_zone = parseRegion("box:3,2,-1,4,3,1");
+  c.max_distance_mm = 1.9;
+  EXPECT_NEAR(FiberFilter(c).zoneDistance(line.data(), n), 2.0, 1e-6);
+  EXPECT_EQ(FiberFilter(c).evaluate(line.data(), n).reason, FilterReason::Distance);
+}
+
 TEST(FiberFilter, orderedIncludesMustBeEnteredInTheirOrder) {
   FilterCriteria c;
   c.include_ordered = {parseRegion("sphere:0,0,0,1.5"), parseRegion("sphere:5,0,0,1.5"),

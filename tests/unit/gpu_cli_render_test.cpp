@@ -158,12 +158,30 @@ TEST_F(GpuCliRender, criteriaHideOrDimTheDroppedFibersAndKeepWhatTheFilterComman
   EXPECT_EQ(dimmed_differ, 0u) << "dimmed: every fiber still drawn";
 }
 
+TEST_F(GpuCliRender, anOpenCutMeshIsAWarningAndStillCuts) {
+  // A box without its top face: open, so "the cut may be approximate".
+  const std::string obj = dir_.file("open.obj");
+  test::writeBytes(obj,
+                  "v -30 -30 -30\nv 30 -30 -30\nv 30 30 -30\nv -30 30 -30\n"
+                  "v -30 -30 30\nv 30 -30 30\nv 30 30 30\nv -30 30 30\n"
+                  "f 1 4 3 2\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n");
+  const std::string png = dir_.file("open.png");
+  const auto r = runGpuFibscope("render --validate --phantom-streamlines 200 --size 96x64 --cut-mesh " + obj +
+                                ":outside --clip-plane 0,0,0,0,0,1 --slab 40 -o " + png);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("warning"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("open.obj"), std::string::npos) << r.output;
+  EXPECT_EQ(pngSize(png), std::make_pair(96u, 64u));
+}
+
 TEST_F(GpuCliRender, badOptionsAreOneLineErrors) {
   const std::string png = dir_.file("x.png");
   for (const std::string options :
        {"--size 0x10", "--size 100", "--pipeline fast", "--culling some", "--color red", "--line-width 9",
         "--background 2,0,0", "--view top", "--camera 1,2", "--view axial --camera 1,2,1",
-        "--include sphere:1,2", "--exclude box:0,0,0,1", "--min-length -3", "--min-length 9 --max-length 2"}) {
+        "--include sphere:1,2", "--exclude box:0,0,0,1", "--min-length -3", "--min-length 9 --max-length 2",
+        "--clip-plane 1,2,3", "--clip-plane 0,0,0,0,0,0", "--slab -2", "--cut-mesh box:0,0,0,1:inside",
+        "--cut-mesh sphere:0,0,0,5", "--cut-mesh /nonexistent/cut.obj:outside", "--roi-set /nonexistent/set.json"}) {
     SCOPED_TRACE(options);
     const auto r = runGpuFibscope("render --phantom-streamlines 10 " + options + " -o " + png);
     EXPECT_EQ(r.exit_code, 2) << r.output;

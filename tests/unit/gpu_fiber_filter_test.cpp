@@ -120,6 +120,16 @@ std::vector<Case> casesFor(const Bounds& b) {
   add("ordered masks", [&](FilterCriteria& c) {
     c.include_ordered = {obliqueMask(cx, cy, cz + 0.3 * ez, 0.25 * ex), obliqueMask(cx, cy, cz - 0.2 * ez, 0.25 * ex)};
   });
+  add("within 15 mm of a point", [&](FilterCriteria& c) {
+    c.distance_zone = SphereRegion{{float(cx + 0.1 * ex), float(cy), float(cz + 0.2 * ez)}, 0.0f};
+    c.max_distance_mm = 0.1 * ex;
+  });
+  add("near an oriented box, ends-only include", [&](FilterCriteria& c) {
+    c.distance_zone = obox;
+    c.max_distance_mm = 0.05 * ex;
+    c.include = {box(-0.5, -0.5, 0.0, 0.5, 0.5, 0.5)};
+    c.ends_only = true;
+  });
   add("length limits", [&](FilterCriteria& c) {
     c.min_length_mm = 0.4 * ex;
     c.max_length_mm = 0.9 * ex;
@@ -187,6 +197,19 @@ TEST_F(GpuFiberFilterTest, keptBitsOfFibletsEqualTheCpuFilterOnTheDecodedPoints)
     size_t kept = 0;
     EXPECT_EQ(mismatches(words, cpu, decoded_, lengths_, kept), 0u);
     EXPECT_EQ(filter_->keptCount(), kept);
+    if (c.criteria.distance_zone) {
+      // Each fiber's distance for colouring: the CPU's, to the rounding of
+      // the GPU's square root.
+      ASSERT_NE(filter_->zoneDistances(), 0u);
+      const std::vector<float> gpu_mm = filter_->zoneDistanceValues();
+      ASSERT_EQ(gpu_mm.size(), src.fibers);
+      size_t far = 0;
+      for (size_t f = 0; f < gpu_mm.size(); ++f) {
+        const float want = cpu.zoneDistance(decoded_.point(decoded_.offsets[f]), decoded_.pointsIn(f));
+        far += !(std::fabs(gpu_mm[f] - want) <= 1e-4f * (1.0f + want));
+      }
+      EXPECT_EQ(far, 0u);
+    }
     // Each case keeps some fibers and drops others, so it could fail.
     EXPECT_GT(kept, 0u);
     EXPECT_LT(kept, fibers_.streamlineCount());

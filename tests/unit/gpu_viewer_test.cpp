@@ -259,8 +259,9 @@ TEST(ViewerInput, dragsShiftClicksAndPanelClicksDoNotPick) {
   EXPECT_TRUE(m.map(button(InputEvent::kLeft, false, true), false, false).empty());
   m.map(click(true, false), /*want_mouse=*/true, false);  // on a panel
   EXPECT_TRUE(m.map(click(false, false), true, false).empty());
-  m.map(button(InputEvent::kRight, true), false, false);
-  EXPECT_TRUE(m.map(button(InputEvent::kRight, false), false, false).empty());
+  m.map(button(InputEvent::kRight, true), false, false);  // places a ROI (dissection), picks no fiber
+  for (const auto& action : m.map(button(InputEvent::kRight, false), false, false))
+    EXPECT_FALSE(std::holds_alternative<PickAction>(action));
 }
 
 TEST(ViewerInput, keysSelectStandardViewsResetAndScreenshot) {

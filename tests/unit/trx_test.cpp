@@ -5,6 +5,7 @@
 // conversion against numpy.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -587,6 +588,40 @@ TEST(TrxWriter, leavesNothingBehindWhenAbandonedOrFailing) {
   options.trx_position_dtype = "float8";
   expectOneLineError(test::errorOf([&] { writeTractogram(path, t, likeFor(t), options); }), path, "float8");
   EXPECT_TRUE(listDirectory(dir.path()).empty());
+}
+
+// A filter's output knows its groups only once the streamlines are written
+// (the viewer's ROI groups): they replace the header's, whose indices (and
+// data per group) were the input's.
+TEST(TrxWriter, groupsSetAfterTheStreamlinesReplaceTheHeadersOnes) {
+  test::TempDir dir;
+  const Tractogram t = test::smallTractogram(6, 3);
+  TractogramHeader like = likeFor(t);
+  like.format = "trx";
+  like.groups.push_back({"input_group", {0, 5}});
+  like.properties.push_back({"dpg/input_group/mean.float32", "[1.5]"});
+  const std::string path = dir.file("grouped.trx");
+  auto writer = createTrxWriter(path, like, {});
+  writer->write(t);
+  writer->setGroups({{"roi_a", {1, 2, 4}}, {"roi_b", {3}}});
+  writer->finish();
+  TractogramHeader header;
+  EXPECT_EQ(readTractogram(path, &header).positions, t.positions);
+  ASSERT_EQ(header.groups.size(), 2u);
+  std::sort(header.groups.begin(), header.groups.end(), [](const Group& a, const Group& b) { return a.name < b.name; });
+  EXPECT_EQ(header.groups[0].name, "roi_a");
+  EXPECT_EQ(header.groups[0].streamlines, (std::vector<uint32_t>{1, 2, 4}));
+  EXPECT_EQ(header.groups[1].name, "roi_b");
+  EXPECT_EQ(header.groups[1].streamlines, std::vector<uint32_t>{3});
+  for (const auto& [key, value] : header.properties) EXPECT_NE(key.rfind("dpg/", 0), 0u) << key;
+
+  // Formats without groups say so.
+  auto tck = createTractogramWriter(dir.file("grouped.tck"), likeFor(t));
+  tck->write(t);
+  tck->setGroups({{"roi_a", {1}}});
+  tck->finish();
+  ASSERT_FALSE(tck->warnings().empty());
+  EXPECT_NE(tck->warnings().back().find("not written"), std::string::npos) << tck->warnings().back();
 }
 
 TEST(TrxWriter, coversThePointsWhenNoReferenceSpaceIsKnown) {

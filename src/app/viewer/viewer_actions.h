@@ -11,6 +11,7 @@
 #include <string_view>
 #include <variant>
 
+#include "app/viewer/dissection.h"
 #include "render/camera.h"
 #include "render/render_settings.h"
 
@@ -69,6 +70,41 @@ struct ExpectSelectedAction {
   uint64_t count = 0;
   std::string where;  // "SCRIPT:LINE"
 };
+// The virtual dissection (dissection.h): a script's change of its state
+// (the panel edits the state itself).
+struct DissectionAction {
+  DissectionEdit edit;
+};
+// roi-save / roi-load: the state as a ROI set file (select/roi_set.h). A
+// load that fails leaves the state as it was and shows the one-line error.
+struct RoiSetFileAction {
+  bool save = true;
+  std::string path;
+};
+// The kept fibers of the active model's source file, streamed through the
+// filter as `fibscope filter` does (viewer_dissection.h), on a thread.
+struct ExportKeptAction {
+  std::string path;
+};
+// A script's check: the run fails (Error "`where`: ...") unless the filter,
+// evaluated now, keeps exactly `count` fibers of the scene drawn.
+struct ExpectKeptAction {
+  uint64_t count = 0;
+  std::string where;  // "SCRIPT:LINE"
+};
+// The mouse on ROIs (viewer_input.h): a sphere placed at the point drawn at
+// window pixel (x, y) (on the focal plane where nothing is drawn); the
+// selected ROI dragged by window pixels in the view plane, or resized by
+// wheel steps (each x or / 1.1).
+struct RoiPlaceAction {
+  double x = 0, y = 0;
+};
+struct RoiDragAction {
+  double dx = 0, dy = 0;
+};
+struct RoiResizeAction {
+  double steps = 0;
+};
 struct ResizeAction {  // the window (or the offscreen image) to this size in pixels
   uint32_t width = 0, height = 0;
 };
@@ -86,8 +122,9 @@ struct SliceStepAction {
 
 using ViewerAction = std::variant<OrbitAction, PanAction, DollyAction, ViewAction, FovAction, SetAction,
                                   ScreenshotAction, OpenAction, CloseModelAction, ModelAction, PickAction, ClearSelectionAction,
-                                  ExportSelectionAction, ExpectSelectedAction, ResizeAction, QuitAction,
-                                  AnatomyAction, SliceStepAction>;
+                                  ExportSelectionAction, ExpectSelectedAction, DissectionAction, RoiSetFileAction,
+                                  ExportKeptAction, ExpectKeptAction, RoiPlaceAction, RoiDragAction, RoiResizeAction,
+                                  ResizeAction, QuitAction, AnatomyAction, SliceStepAction>;
 
 // Sets one RenderSettings field from text, as `set KEY VALUE` in a script:
 // KEY is a setting's name in render/settings_table.h (the command line's

@@ -17,17 +17,20 @@
 #include "app/model_loader.h"
 #include "app/open_input.h"
 #include "app/viewer/adaptive_detail.h"
-#include "app/viewer/viewer_anatomy.h"
+#include "app/viewer/dissection.h"
 #include "app/viewer/imgui_layer.h"
 #include "app/viewer/orbit_controller.h"
 #include "app/viewer/presentation.h"
 #include "app/viewer/recent_files.h"
+#include "app/viewer/viewer_anatomy.h"
+#include "app/viewer/viewer_dissection.h"
 #include "app/viewer/viewer_input.h"
 #include "app/viewer/viewer_script.h"
 #include "app/viewer/viewer_selection.h"
 #include "app/viewer/viewer_state.h"
 #include "app/viewer/viewer_ui.h"
 #include "app/viewer/viewer_window.h"
+#include "codec/fbl_codec.h"
 #include "codec/fbl_reader.h"
 #include "core/error.h"
 #include "gpu/submit.h"
@@ -42,6 +45,7 @@
 #include "render/gpu/raw_tractogram.h"
 #include "render/gpu/scene_table.h"
 #include "render/gpu/upscale_pass.h"
+#include "select/fiber_filter.h"
 
 namespace fibscope {
 namespace {
@@ -57,6 +61,9 @@ struct ViewerModel {
   GpuDataset fiblets;
   GpuRawTractogram raw;
   bool has_raw = false;
+  // The step its source file's header states (the length limits' margin,
+  // as `fibscope filter` takes it), NaN when none.
+  float step_size_mm = NAN;
 };
 
 // What the next frame draws: every visible model's fiblets in one scene
@@ -66,7 +73,10 @@ struct FrameScene {
   std::vector<int> models;  // the drawn models (indices into the list), in the scene's order
   GpuScene gpu;
   SceneLayout layout;        // of gpu.datasets: picks map fiber ids back through it
-  RenderSettings settings;   // the state's, with a baseline not ready replaced by compute
+  RenderSettings settings;   // the state's, with a baseline not ready replaced by compute, and the dissection's cuts
+  // The dissection draws the kept fibers as the selection (dropped ones
+  // dimmed): gpu.selection_bits holds its bits, not the picked selection's.
+  bool dissection_selects = false;
   bool empty() const { return models.empty(); }
 };
 
@@ -144,8 +154,19 @@ class ViewerApp {
   void frameVisibleModels();
   void fitScalarRange();
   // What the next frame draws (between frames: the scene's fiber lengths
-  // may be copied).
-  FrameScene currentScene();
+  // may be copied, the dissection's filter evaluated; `filter_now`: without
+  // waiting for a drag to settle).
+  FrameScene currentScene(bool filter_now = false);
+  FrameScene sceneToDraw();
+  // The dissection (viewer_dissection.h) on `scene`: its cuts in the
+  // settings, its kept bits in the GpuScene.
+  void dissect(FrameScene& scene, bool now);
+  void applyDissection(const ViewerAction& action);
+  void pollExport();
+  // The fiber drawn at window pixel (x, y) of the last frame (no hit when
+  // none is drawn there or no frame is).
+  PickResult pickDrawn(double x, double y);
+  void placeRoiAt(double x, double y);
   uint64_t activeModelId() const;
   void ensureRawFor(int model);
   void pollRawDecode();
@@ -193,6 +214,8 @@ class ViewerApp {
   std::vector<uint64_t> scalar_range_ids_;  // the visible models the scalar range was fitted to
   std::unique_ptr<ViewerSelection> selection_;
   std::unique_ptr<GpuSceneFiberLengths> scene_lengths_;  // the scalar colour mode's per-fiber values
+  std::unique_ptr<ViewerDissection> dissection_;
+  bool dissection_opened_ = false;  // the panel was opened for the dissection's first ROI or plane
   ViewerAnatomy anatomy_;  // the anatomical image shown as slices
   // The scene the G-buffer shows (the last frame drawn; no models after a
   // resize or a frame without a model): picks map its fiber ids to the
@@ -236,6 +259,14 @@ ViewerApp::ViewerApp(const ViewerOptions& options) : options_(options) {
   // The script first: a malformed one is reported before a window opens.
   if (!options_.script.empty()) script_ = ScriptRunner(loadScript(options_.script));
   state_.settings = options_.settings;
+  // The dissection owns the clip planes: the command line's (--clip-plane,
+  // a --roi-set's) become its planes, before the ROIs' set's own.
+  state_.dissection.set = options_.dissection;
+  std::vector<RoiClipPlane> planes = clipPlanesFromSettings(state_.settings.clip_planes);
+  planes.insert(planes.end(), options_.dissection.clip_planes.begin(), options_.dissection.clip_planes.end());
+  state_.dissection.set.clip_planes = std::move(planes);
+  state_.settings.clip_planes.clear();
+  state_.dissection.dim_dropped = options_.dim_dropped;
 
   if (!options_.offscreen) {
     std::string why_not;
@@ -279,6 +310,7 @@ void ViewerApp::createFrameObjects() {
   renderer_ = std::make_unique<FrameRenderer>(*context_, width, height);
   selection_ = std::make_unique<ViewerSelection>(*context_);
   scene_lengths_ = std::make_unique<GpuSceneFiberLengths>(*context_);
+  dissection_ = std::make_unique<ViewerDissection>(*context_);
 
   VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
   alloc.commandPool = context_->commandPool();
@@ -340,6 +372,7 @@ void ViewerApp::release() {
   renderer_.reset();
   selection_.reset();
   scene_lengths_.reset();
+  dissection_.reset();  // cancels an export
   anatomy_.unload(state_);
   scenes_.clear();
   destroyPresentation(*context_, presentation_);
@@ -412,6 +445,15 @@ void ViewerApp::addModel(LoadEvent& event) {
   auto model = std::make_unique<ViewerModel>();
   model->id = next_model_id_++;
   model->fiblets = GpuDataset::upload(*context_, data.fbl);
+  if (const FblSection* source = data.fbl.find(kFblSectionSource)) {
+    try {
+      const auto text = data.fbl.data(*source);
+      const std::string_view json(reinterpret_cast<const char*>(text.data()), text.size());
+      model->step_size_mm = headerStepSize(headerFromFblSource(json, data.fbl.path()));
+    } catch (const Error&) {
+      // No margin then (the opening checked the section already).
+    }
+  }
   const double upload_seconds = std::chrono::duration<double>(Clock::now() - start).count();
 
   ModelInfo info;
@@ -496,7 +538,10 @@ void ViewerApp::frameVisibleModels() {
     first = false;
     sample.insert(sample.end(), data.sample.begin(), data.sample.end());
   }
-  if (!first) controller_.frame(bounds, sample);
+  if (!first) {
+    controller_.frame(bounds, sample);
+    state_.scene_bounds = bounds;
+  }
 }
 
 void ViewerApp::fitScalarRange() {
@@ -532,7 +577,35 @@ uint64_t ViewerApp::activeModelId() const {
   return m >= 0 && m < int(scenes_.size()) ? scenes_[size_t(m)]->id : 0;
 }
 
-FrameScene ViewerApp::currentScene() {
+FrameScene ViewerApp::currentScene(bool filter_now) {
+  FrameScene scene = sceneToDraw();
+  dissect(scene, filter_now);
+  return scene;
+}
+
+void ViewerApp::dissect(FrameScene& scene, bool now) {
+  addDissectionCuts(state_.dissection.set, scene.settings);
+  const bool baseline = scene.settings.pipeline != RenderPipeline::Compute && scene.gpu.raw != nullptr;
+  DissectionScene d;
+  d.layout = &scene.layout;
+  if (!scene.models.empty()) {
+    const ViewerModel& first = *scenes_[size_t(scene.models.front())];
+    d.step_size_mm = first.step_size_mm;  // the models of one scene rarely differ; the first one's margin
+    if (baseline) {
+      d.raw = scene.gpu.raw;
+      d.raw_lengths = first.fiblets.fiberLength().address;  // the raw vertices are its fibers, in order
+    }
+  }
+  try {
+    finishFrame();  // an update rewrites the bits the frame in flight reads
+    dissection_->evaluate(state_.dissection, d, now);
+  } catch (const Error& e) {
+    state_.status = e.what();
+  }
+  scene.dissection_selects = dissection_->apply(state_.dissection, scene.gpu, baseline);
+}
+
+FrameScene ViewerApp::sceneToDraw() {
   FrameScene scene;
   scene.settings = state_.settings;
   state_.baseline_draws_active_only = false;
@@ -701,6 +774,11 @@ void ViewerApp::apply(const ViewerAction& action) {
           if (selection_->size() != a.count)
             throw Error(a.where + ": expect-selected " + std::to_string(a.count) + ": " +
                         std::to_string(selection_->size()) + " fibers are selected");
+        } else if constexpr (std::is_same_v<A, DissectionAction> || std::is_same_v<A, RoiSetFileAction> ||
+                             std::is_same_v<A, ExportKeptAction> || std::is_same_v<A, ExpectKeptAction> ||
+                             std::is_same_v<A, RoiPlaceAction> || std::is_same_v<A, RoiDragAction> ||
+                             std::is_same_v<A, RoiResizeAction>) {
+          applyDissection(action);
         } else if constexpr (std::is_same_v<A, QuitAction>) {
           quit_ = true;
         } else if constexpr (std::is_same_v<A, AnatomyAction>) {
@@ -710,6 +788,124 @@ void ViewerApp::apply(const ViewerAction& action) {
         }
       },
       action);
+}
+
+void ViewerApp::applyDissection(const ViewerAction& action) {
+  DissectionState& d = state_.dissection;
+  auto report = [&](const std::string& message) {
+    state_.status = message;
+    std::fprintf(stderr, "fibscope view: %s\n", message.c_str());
+  };
+  auto selectedRoi = [&]() -> Roi* {
+    return d.selected >= 0 && d.selected < int(d.set.rois.size()) ? &d.set.rois[size_t(d.selected)] : nullptr;
+  };
+  try {
+    std::visit(
+        [&](const auto& a) {
+          using A = std::decay_t<decltype(a)>;
+          if constexpr (std::is_same_v<A, DissectionAction>) {
+            applyDissectionEdit(d, state_.settings, a.edit);
+          } else if constexpr (std::is_same_v<A, RoiSetFileAction>) {
+            if (a.save) {
+              saveRoiSet(roiSetToSave(d, state_.settings), a.path);
+              d.file_message = "saved " + a.path;
+            } else {
+              // Read whole before anything changes: a bad file leaves the state.
+              RoiSet set = loadRoiSet(a.path);
+              loadRoiSetIntoState(std::move(set), d, state_.settings);
+              d.file_message = "loaded " + a.path;
+            }
+            state_.status = d.file_message;
+          } else if constexpr (std::is_same_v<A, ExportKeptAction>) {
+            const int m = state_.active_model;
+            if (m < 0 || m >= int(scenes_.size())) throw Error(a.path + ": no model to export from");
+            const ModelData& data = *scenes_[size_t(m)]->data;
+            DissectionExportSource source;
+            source.model = data.name;
+            source.path = data.source_path;
+            source.phantom.streamlines = options_.phantom_streamlines;
+            source.phantom.seed = loader_->options().phantom_seed;  // the loader's phantom, made again
+            dissection_->startExport(d, source, a.path);
+            d.exporting = true;
+            state_.status = "exporting the kept fibers of " + data.name + " to " + a.path;
+          } else if constexpr (std::is_same_v<A, ExpectKeptAction>) {
+            currentScene(/*filter_now=*/true);
+            const DissectionStats& stats = d.stats;
+            if (!stats.error.empty())
+              throw Error(a.where + ": expect-kept " + std::to_string(a.count) + ": " + stats.error);
+            if (stats.kept != a.count)
+              throw Error(a.where + ": expect-kept " + std::to_string(a.count) + ": " + std::to_string(stats.kept) +
+                          " of " + std::to_string(stats.fibers) + " fibers are kept");
+            std::fprintf(stderr, "fibscope view: %s: kept %llu of %llu fibers (last filter update %.1f ms)\n",
+                         a.where.c_str(), static_cast<unsigned long long>(stats.kept),
+                         static_cast<unsigned long long>(stats.fibers), stats.update_ms);
+          } else if constexpr (std::is_same_v<A, RoiPlaceAction>) {
+            placeRoiAt(a.x, a.y);
+          } else if constexpr (std::is_same_v<A, RoiDragAction>) {
+            if (Roi* roi = selectedRoi())
+              if (const std::optional<glm::dvec3> at = regionCenter(roi->region))
+                roi->region = movedRegion(roi->region, viewPlaneDrag(state_.camera, *at, a.dx, a.dy));
+          } else if constexpr (std::is_same_v<A, RoiResizeAction>) {
+            if (Roi* roi = selectedRoi()) roi->region = scaledRegion(roi->region, std::pow(1.1, a.steps));
+          }
+        },
+        action);
+  } catch (const Error& e) {
+    if (std::holds_alternative<ExpectKeptAction>(action)) throw;  // the script fails, naming its line
+    if (std::holds_alternative<RoiSetFileAction>(action)) d.file_message = e.what();
+    report(e.what());
+  }
+}
+
+void ViewerApp::placeRoiAt(double x, double y) {
+  // On the fiber drawn there, else on the focal plane under the cursor.
+  const PickResult pick = pickDrawn(x, y);
+  const Camera& camera = drawn_ids_.empty() ? state_.camera : last_camera_;  // the camera of the G-buffer picked
+  double depth = pick.depth;
+  if (!pick.hit) {
+    const std::array<double, 16> m = viewProjectionD(camera);
+    const Vec3d& t = camera.target;
+    const double z = m[2] * t[0] + m[6] * t[1] + m[10] * t[2] + m[14];
+    const double w = m[3] * t[0] + m[7] * t[1] + m[11] * t[2] + m[15];
+    depth = z / w;
+  }
+  const std::optional<Vec3d> at = unprojectPixel(camera, std::floor(x), std::floor(y), depth);
+  if (!at) {
+    state_.status = "no point to place a ROI at there";
+    return;
+  }
+  DissectionState& d = state_.dissection;
+  const std::string name = uniqueRoiName(d.set, "sphere");
+  applyDissectionEdit(d, state_.settings,
+                      RoiAddEdit{name, RoiRole::Include,
+                                 sphereAt({(*at)[0], (*at)[1], (*at)[2]}, defaultRoiRadius(state_.scene_bounds))});
+  char line[160];
+  std::snprintf(line, sizeof line, "%s at %.1f, %.1f, %.1f mm (%s)", name.c_str(), (*at)[0], (*at)[1], (*at)[2],
+                pick.hit ? "on the fiber there" : "on the focal plane");
+  state_.status = line;
+}
+
+void ViewerApp::pollExport() {
+  DissectionState& d = state_.dissection;
+  try {
+    const std::optional<DissectionExportResult> done = dissection_->pollExport();
+    if (!done) return;
+    d.exporting = false;
+    for (const std::string& w : done->warnings) std::fprintf(stderr, "fibscope view: warning: %s\n", w.c_str());
+    char line[512];
+    std::snprintf(line, sizeof line, "exported %llu of %llu fibers of %s to %s in %.2f s", 
+                  static_cast<unsigned long long>(done->kept), static_cast<unsigned long long>(done->streamlines),
+                  done->model.c_str(), done->path.c_str(), done->seconds);
+    d.file_message = line;
+    if (done->groups > 0) d.file_message += " (" + std::to_string(done->groups) + " ROI groups)";
+    state_.status = d.file_message;
+    std::fprintf(stderr, "fibscope view: %s\n", d.file_message.c_str());
+  } catch (const Error& e) {
+    d.exporting = false;
+    d.file_message = e.what();
+    state_.status = e.what();
+    std::fprintf(stderr, "fibscope view: %s\n", e.what());
+  }
 }
 
 std::string ViewerApp::freshScreenshotPath() {
@@ -770,21 +966,24 @@ void ViewerApp::syncSelection(const FrameScene& scene) {
   }
 }
 
+PickResult ViewerApp::pickDrawn(double x, double y) {
+  finishFrame();
+  if (drawn_ids_.empty() || !(x >= 0 && y >= 0 && x < presentation_.width && y < presentation_.height)) return {};
+  // The G-buffer of the renderer that drew it (a coarse frame's is
+  // smaller): window pixels scaled to its size.
+  const GpuFrameTargets& drawn = (recorded_renderer_ ? recorded_renderer_ : renderer_.get())->targets();
+  return pickFiber(*context_, drawn, uint32_t(uint64_t(x) * drawn.width / presentation_.width),
+                   uint32_t(uint64_t(y) * drawn.height / presentation_.height));
+}
+
 void ViewerApp::pickAt(const PickAction& pick) {
   try {
-    finishFrame();
     // The G-buffer holds the last frame drawn: its scene-global fiber ids
     // map to (model, fiber) through that frame's layout.
     std::optional<SelectedEntry> hit;
     std::string what = "no fiber there: ";
-    if (!drawn_ids_.empty() && pick.x >= 0 && pick.y >= 0 && pick.x < presentation_.width &&
-        pick.y < presentation_.height) {
-      // The G-buffer of the renderer that drew it (a coarse frame's is
-      // smaller): window pixels scaled to its size.
-      const GpuFrameTargets& drawn = (recorded_renderer_ ? recorded_renderer_ : renderer_.get())->targets();
-      const PickResult result =
-          pickFiber(*context_, drawn, uint32_t(uint64_t(pick.x) * drawn.width / presentation_.width),
-                    uint32_t(uint64_t(pick.y) * drawn.height / presentation_.height));
+    {
+      const PickResult result = pickDrawn(pick.x, pick.y);
       if (result.hit) {
         if (const std::optional<SceneFiber> at = locateSceneFiber(drawn_layout_, result.fiber)) {
           hit = SelectedEntry{drawn_ids_[at->dataset], at->fiber};
@@ -809,7 +1008,7 @@ void ViewerApp::pickAt(const PickAction& pick) {
 GpuScene ViewerApp::withSelection(const FrameScene& scene) const {
   // The bits were uploaded for this scene's numbering by syncSelection(scene).
   GpuScene gpu = scene.gpu;
-  gpu.selection_bits = selection_->bits();
+  if (!scene.dissection_selects) gpu.selection_bits = selection_->bits();
   gpu.anatomy = anatomy_.gpu();  // the slices with whatever models are drawn
   return gpu;
 }
@@ -922,6 +1121,13 @@ bool ViewerApp::drawFrame(uint32_t width, uint32_t height, double dt) {
   }
 
   imgui_->newFrame(width, height, dt);
+  state_.camera = controller_.camera(width, height);  // the panel's focal point and the ROIs' outlines
+  // The dissection panel opens with the first ROI or plane (once: closed
+  // again, it stays closed).
+  if (!dissection_opened_ && (!state_.dissection.set.rois.empty() || !state_.dissection.set.clip_planes.empty())) {
+    state_.show_dissection = true;
+    dissection_opened_ = true;
+  }
   for (const ViewerAction& action : drawViewerUi(state_)) apply(action);
   // A model added or closed: the camera frames every visible model. Show,
   // hide and switching the active model keep the view (the user may hide a
@@ -1009,6 +1215,7 @@ void ViewerApp::run() {
     finishFrame();
     pollLoads();  // after the fence: uploads run on this thread, nothing in flight
     pollRawDecode();
+    pollExport();
     // Frames and the script count once the models named at start are in.
     const bool starting = !startup_jobs_.empty();
     const auto now = Clock::now();
@@ -1024,7 +1231,7 @@ void ViewerApp::run() {
         for (const ViewerAction& action : input_.map(event, imgui_->wantsMouse(), imgui_->wantsKeyboard()))
           apply(action);
     if (!starting)
-      for (const ViewerAction& action : script_.nextFrame(loader_->busy())) apply(action);
+      for (const ViewerAction& action : script_.nextFrame(loader_->busy(), dissection_->exporting())) apply(action);
     if (!starting && options_.orbit_deg_per_frame != 0)
       controller_.rotate(options_.orbit_deg_per_frame / OrbitController::kDegreesPerPixel, 0);
     // A quit still draws this frame: a screenshot asked for with it is taken.

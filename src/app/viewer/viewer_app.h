@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "render/render_settings.h"
+#include "select/roi_set.h"
 
 namespace fibscope {
 
@@ -33,6 +34,10 @@ struct ViewerOptions {
   // settings' scalar range was given (--scalar-range): kept, where otherwise
   // each model shown sets it to its fibers' lengths.
   bool keep_scalar_range = false;
+  // The dissection to start with (--roi-set, --include ...: cmd_view.cpp);
+  // settings.clip_planes join its planes.
+  RoiSet dissection;
+  bool dim_dropped = false;
   // An anatomical image shown as slices from the start (--anatomy), with
   // the settings the command line gave (kept for it: slice positions and
   // display range), by their names in render/settings_table.h.

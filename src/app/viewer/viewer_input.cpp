@@ -19,6 +19,17 @@ std::vector<ViewerAction> InputMapper::map(const InputEvent& e, bool want_mouse,
       if (have_cursor_ && (dx != 0 || dy != 0)) {
         if (drag_ == Drag::Orbit) actions.push_back(OrbitAction{dx, dy});
         if (drag_ == Drag::Pan) actions.push_back(PanAction{dx, dy});
+        if (drag_ == Drag::MoveRoi) {
+          // Within the slop it may still be a click (a sphere placed): the
+          // ROI moves once the cursor leaves it, by the whole way from the press.
+          if (roi_click_armed_ &&
+              (std::abs(e.x - press_x_) > kClickSlopPx || std::abs(e.y - press_y_) > kClickSlopPx)) {
+            roi_click_armed_ = false;
+            actions.push_back(RoiDragAction{e.x - press_x_, e.y - press_y_});
+          } else if (!roi_click_armed_) {
+            actions.push_back(RoiDragAction{dx, dy});
+          }
+        }
       }
       last_x_ = e.x;
       last_y_ = e.y;
@@ -30,6 +41,10 @@ std::vector<ViewerAction> InputMapper::map(const InputEvent& e, bool want_mouse,
         if (e.button == InputEvent::kLeft && click_armed_) {
           actions.push_back(PickAction{press_x_, press_y_, click_add_});
           click_armed_ = false;
+        }
+        if (e.button == InputEvent::kRight && roi_click_armed_) {
+          actions.push_back(RoiPlaceAction{press_x_, press_y_});
+          roi_click_armed_ = false;
         }
         if (e.button == drag_button_) {
           drag_ = Drag::None;
@@ -45,11 +60,20 @@ std::vector<ViewerAction> InputMapper::map(const InputEvent& e, bool want_mouse,
           press_y_ = last_y_;
         }
         if (e.button == InputEvent::kMiddle) drag_ = Drag::Pan;
+        if (e.button == InputEvent::kRight && have_cursor_) {
+          drag_ = Drag::MoveRoi;
+          roi_click_armed_ = true;
+          press_x_ = last_x_;
+          press_y_ = last_y_;
+        }
         if (drag_ != Drag::None) drag_button_ = e.button;
       }
       break;
     case InputEvent::Type::Scroll:
-      if (!want_mouse && e.y != 0) actions.push_back(DollyAction{e.y});
+      if (!want_mouse && e.y != 0) {
+        if (e.shift) actions.push_back(RoiResizeAction{e.y});
+        else actions.push_back(DollyAction{e.y});
+      }
       break;
     case InputEvent::Type::Key:
       if (!e.pressed || want_keyboard) break;
@@ -68,6 +92,15 @@ std::vector<ViewerAction> InputMapper::map(const InputEvent& e, bool want_mouse,
           break;
         case GLFW_KEY_R:
           actions.push_back(ViewAction{});
+          break;
+        case GLFW_KEY_DELETE:
+          actions.push_back(DissectionAction{RoiRemoveEdit{}});  // the selected ROI
+          break;
+        case GLFW_KEY_RIGHT_BRACKET:
+          actions.push_back(RoiResizeAction{1});
+          break;
+        case GLFW_KEY_LEFT_BRACKET:
+          actions.push_back(RoiResizeAction{-1});
           break;
         case GLFW_KEY_F12:
         case GLFW_KEY_P:

@@ -5,9 +5,12 @@
 // Page Up/Down move it a voxel (shift: ten); dropped files are opened
 // (.nii/.nii.gz as the anatomical image). A left click
 // (press and release within kClickSlopPx) picks the fiber under it,
-// ctrl + click adds it to (or removes it from) the selection. ImGui gets the
-// mouse and keyboard first when it wants them (a drag that starts on a
-// panel stays with the panel).
+// ctrl + click adds it to (or removes it from) the selection. The
+// dissection's ROIs: a right click places a sphere at the fiber under the
+// cursor (on the focal plane over the background), a right drag moves the
+// selected ROI in the view plane, shift + wheel or ] and [ resize it,
+// Delete removes it. ImGui gets the mouse and keyboard first when it wants
+// them (a drag that starts on a panel stays with the panel).
 #pragma once
 
 #include <string>
@@ -41,7 +44,7 @@ class InputMapper {
   static constexpr double kClickSlopPx = 3.0;
 
  private:
-  enum class Drag : uint8_t { None, Orbit, Pan };
+  enum class Drag : uint8_t { None, Orbit, Pan, MoveRoi };
   Drag drag_ = Drag::None;
   int drag_button_ = -1;
   bool have_cursor_ = false;
@@ -49,6 +52,7 @@ class InputMapper {
   // The left press that may become a click: where, with ctrl, and whether
   // the cursor has left the slop since.
   bool click_armed_ = false, click_add_ = false;
+  bool roi_click_armed_ = false;  // the right press that may become a click (a sphere placed)
   double press_x_ = 0, press_y_ = 0;
 };
 

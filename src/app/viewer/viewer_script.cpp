@@ -3,10 +3,13 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include "app/render_options.h"
 #include "core/error.h"
+#include "select/cuts.h"
+#include "select/region.h"
 
 namespace fibscope {
 namespace {
@@ -38,8 +41,113 @@ void expectArguments(const std::vector<std::string_view>& words, size_t min, siz
   if (n < min || n > max) throw Error(std::string("expected '") + usage + "', got " + std::to_string(n) + " arguments");
 }
 
-std::variant<ViewerAction, WaitFrames, WaitLoaded> parseCommand(const std::vector<std::string_view>& w) {
+bool onOff(std::string_view word, const char* command) {
+  if (word == "on") return true;
+  if (word == "off") return false;
+  throw Error(std::string(command) + ": expected on or off, got '" + std::string(word) + "'");
+}
+
+// A length limit in mm, or '-' for none (NaN).
+double lengthLimit(std::string_view word, const char* what) {
+  if (word == "-") return NAN;
+  const double v = number(word, what);
+  if (!(v >= 0)) throw Error(std::string(what) + ": expected a length >= 0 mm or -, got " + std::string(word));
+  return v;
+}
+
+std::string jsonPath(std::string_view word, const char* command) {
+  const std::string path(word);
+  if (path.size() < 6 || path.substr(path.size() - 5) != ".json")
+    throw Error(std::string(command) + ": expected a .json file, got '" + path + "'");
+  return path;
+}
+
+// The dissection's commands (dissection.h), or nullopt for another name.
+std::optional<ViewerAction> parseDissectionCommand(const std::vector<std::string_view>& w) {
   const std::string_view name = w[0];
+  if (name == "roi-add") {
+    expectArguments(w, 3, 3, "roi-add NAME include|exclude|include_ordered SPEC");
+    RoiAddEdit add;
+    add.name = std::string(w[1]);
+    if (w[2] == "include") add.role = RoiRole::Include;
+    else if (w[2] == "exclude") add.role = RoiRole::Exclude;
+    else if (w[2] == "include_ordered") add.role = RoiRole::IncludeOrdered;
+    else throw Error("roi-add: expected include, exclude or include_ordered, got '" + std::string(w[2]) + "'");
+    add.region = parseRegion(w[3]);
+    return ViewerAction{DissectionAction{add}};
+  }
+  if (name == "roi-place") {
+    expectArguments(w, 2, 2, "roi-place X Y");
+    const double x = number(w[1], "X"), y = number(w[2], "Y");
+    if (!(x >= 0 && x < 65536 && y >= 0 && y < 65536))
+      throw Error("roi-place: expected window pixels from 0 to 65535, got " + std::string(w[1]) + " " +
+                  std::string(w[2]));
+    return ViewerAction{RoiPlaceAction{x, y}};
+  }
+  if (name == "roi-remove") {
+    expectArguments(w, 1, 1, "roi-remove NAME");
+    return ViewerAction{DissectionAction{RoiRemoveEdit{std::string(w[1])}}};
+  }
+  if (name == "roi-enable") {
+    expectArguments(w, 2, 2, "roi-enable NAME on|off");
+    return ViewerAction{DissectionAction{RoiEnableEdit{std::string(w[1]), onOff(w[2], "roi-enable")}}};
+  }
+  if (name == "ends-only") {
+    expectArguments(w, 1, 1, "ends-only on|off");
+    return ViewerAction{DissectionAction{EndsOnlyEdit{onOff(w[1], "ends-only")}}};
+  }
+  if (name == "length") {
+    expectArguments(w, 2, 2, "length MIN|- MAX|-");
+    const double lo = lengthLimit(w[1], "MIN"), hi = lengthLimit(w[2], "MAX");
+    if (lo > hi) throw Error("length: MIN " + std::string(w[1]) + " lies above MAX " + std::string(w[2]));
+    return ViewerAction{DissectionAction{LengthEdit{lo, hi}}};
+  }
+  if (name == "clip-plane-add") {
+    expectArguments(w, 1, 1, "clip-plane-add PX,PY,PZ,NX,NY,NZ");
+    return ViewerAction{DissectionAction{ClipPlaneAddEdit{parseClipPlane(w[1])}}};
+  }
+  if (name == "clip-plane-clear") {
+    expectArguments(w, 0, 0, "clip-plane-clear");
+    return ViewerAction{DissectionAction{ClipPlaneClearEdit{}}};
+  }
+  if (name == "slab") {
+    expectArguments(w, 1, 1, "slab MM");
+    const double mm = number(w[1], "MM");
+    if (!(mm >= 0 && mm <= 1000)) throw Error("slab: expected 0 (none) to 1000 mm, got " + std::string(w[1]));
+    return ViewerAction{DissectionAction{SlabEdit{float(mm)}}};
+  }
+  if (name == "dropped") {
+    expectArguments(w, 1, 1, "dropped hide|dim");
+    if (w[1] != "hide" && w[1] != "dim")
+      throw Error("dropped: expected hide or dim, got '" + std::string(w[1]) + "'");
+    return ViewerAction{DissectionAction{DroppedEdit{w[1] == "dim"}}};
+  }
+  if (name == "roi-save" || name == "roi-load") {
+    const bool save = name == "roi-save";
+    expectArguments(w, 1, 1, save ? "roi-save FILE.json" : "roi-load FILE.json");
+    return ViewerAction{RoiSetFileAction{save, jsonPath(w[1], save ? "roi-save" : "roi-load")}};
+  }
+  if (name == "export-kept") {
+    expectArguments(w, 1, 1, "export-kept OUT.tck|OUT.trk|OUT.trx");
+    const std::string path(w[1]);
+    auto ends = [&](const char* ext) { return path.size() > 4 && path.substr(path.size() - 4) == ext; };
+    if (!ends(".tck") && !ends(".trk") && !ends(".trx"))
+      throw Error("export-kept: the output must be a .tck, .trk or .trx file, got '" + path + "'");
+    return ViewerAction{ExportKeptAction{path}};
+  }
+  if (name == "expect-kept") {
+    expectArguments(w, 1, 1, "expect-kept N");
+    const double n = number(w[1], "N");
+    if (!(n >= 0 && n <= 4294967295.0) || n != std::floor(n))
+      throw Error("expect-kept: expected a fiber count, got " + std::string(w[1]));
+    return ViewerAction{ExpectKeptAction{uint64_t(n), {}}};
+  }
+  return std::nullopt;
+}
+
+std::variant<ViewerAction, WaitFrames, WaitLoaded, WaitExported> parseCommand(const std::vector<std::string_view>& w) {
+  const std::string_view name = w[0];
+  if (std::optional<ViewerAction> dissection = parseDissectionCommand(w)) return *dissection;
   if (name == "orbit" || name == "pan") {
     expectArguments(w, 2, 2, name == "orbit" ? "orbit DX DY" : "pan DX DY");
     const double dx = number(w[1], "DX"), dy = number(w[2], "DY");
@@ -147,7 +255,9 @@ std::variant<ViewerAction, WaitFrames, WaitLoaded> parseCommand(const std::vecto
   }
   throw Error("unknown command '" + std::string(name) +
               "' (expected orbit, pan, dolly, view, fov, set, wait, wait-loaded, open, model, screenshot, "
-              "pick, clear-selection, export-selection, expect-selected, resize, anatomy or quit)");
+              "pick, clear-selection, export-selection, expect-selected, roi-add, roi-place, roi-remove, "
+              "roi-enable, ends-only, length, clip-plane-add, clip-plane-clear, slab, dropped, roi-save, roi-load, "
+              "export-kept, expect-kept, resize, anatomy or quit)");
 }
 
 }  // namespace
@@ -168,9 +278,14 @@ std::vector<ScriptStep> parseScript(std::string_view text, const std::string& pa
     try {
       steps.push_back({line_number, parseCommand(words)});
       // A failed expectation names the script line it came from.
-      if (auto* action = std::get_if<ViewerAction>(&steps.back().command))
+      if (auto* action = std::get_if<ViewerAction>(&steps.back().command)) {
         if (auto* expect = std::get_if<ExpectSelectedAction>(action))
           expect->where = path + ":" + std::to_string(line_number);
+        if (auto* expect = std::get_if<ExpectKeptAction>(action))
+          expect->where = path + ":" + std::to_string(line_number);
+        // export-kept holds the script until the file is written.
+        if (std::holds_alternative<ExportKeptAction>(*action)) steps.push_back({line_number, WaitExported{}});
+      }
     } catch (const Error& e) {
       throw Error(path + ":" + std::to_string(line_number) + ": " + e.what());
     }
@@ -186,11 +301,15 @@ std::vector<ScriptStep> loadScript(const std::string& path) {
   return parseScript(text.str(), path);
 }
 
-std::vector<ViewerAction> ScriptRunner::nextFrame(bool loading) {
+std::vector<ViewerAction> ScriptRunner::nextFrame(bool loading, bool exporting) {
   std::vector<ViewerAction> actions;
   if (waiting_loaded_) {
     if (loading) return actions;
     waiting_loaded_ = false;
+  }
+  if (waiting_exported_) {
+    if (exporting) return actions;
+    waiting_exported_ = false;
   }
   if (waiting_ > 0) {
     --waiting_;
@@ -206,6 +325,12 @@ std::vector<ViewerAction> ScriptRunner::nextFrame(bool loading) {
       // Checked from the next frame on: an `open` just above is requested
       // when these actions are applied, so the loader is busy by then.
       waiting_loaded_ = true;
+      break;
+    }
+    if (std::holds_alternative<WaitExported>(step.command)) {
+      // The export was started by the actions of this frame: checked from
+      // the next frame on, as wait-loaded.
+      waiting_exported_ = true;
       break;
     }
     actions.push_back(std::get<ViewerAction>(step.command));

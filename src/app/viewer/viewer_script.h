@@ -17,6 +17,16 @@
 //   expect-selected N           (the run fails naming the line unless N are selected)
 //   resize W H                 (the window, or the offscreen image, in pixels)
 //   anatomy FILE.nii[.gz]       (the anatomical image shown as slices; viewer_anatomy.h)
+// the virtual dissection (dissection.h, viewer_dissection.h):
+//   roi-add NAME include|exclude|include_ordered SPEC   (select/region.h's SPEC; a new NAME)
+//   roi-place X Y              (a sphere on the fiber drawn at that window pixel: the right click)
+//   roi-remove NAME | roi-enable NAME on|off
+//   ends-only on|off | length MIN MAX   (mm, '-': no limit)
+//   clip-plane-add PX,PY,PZ,NX,NY,NZ    (keeps the side the normal points to) | clip-plane-clear
+//   slab MM                    (around the focal plane; 0: none) | dropped hide|dim
+//   roi-save FILE.json | roi-load FILE.json   (a load that fails keeps the state, the error is shown)
+//   export-kept OUT.tck|.trk|.trx  (the active model's kept fibers, as `fibscope filter`; holds until written)
+//   expect-kept N              (the run fails naming the line unless the filter keeps N fibers)
 //   quit
 #pragma once
 
@@ -36,9 +46,12 @@ struct WaitFrames {
 
 struct WaitLoaded {};
 
+// Follows export-kept: holds until the export is written.
+struct WaitExported {};
+
 struct ScriptStep {
   int line = 0;  // 1-based, for messages
-  std::variant<ViewerAction, WaitFrames, WaitLoaded> command;
+  std::variant<ViewerAction, WaitFrames, WaitLoaded, WaitExported> command;
 };
 
 // Parses a whole script. `path` only names the script in messages. Throws
@@ -55,10 +68,13 @@ class ScriptRunner {
   explicit ScriptRunner(std::vector<ScriptStep> steps) : steps_(std::move(steps)) {}
 
   // The actions to apply before the next frame: every command up to the
-  // next `wait` (which then holds for its frames) or `wait-loaded` (which
-  // holds while `loading`), or none while waiting.
-  std::vector<ViewerAction> nextFrame(bool loading = false);
-  bool finished() const { return next_ >= steps_.size() && waiting_ == 0 && !waiting_loaded_; }
+  // next `wait` (which then holds for its frames), `wait-loaded` (which
+  // holds while `loading`) or export-kept (holds while `exporting`), or
+  // none while waiting.
+  std::vector<ViewerAction> nextFrame(bool loading = false, bool exporting = false);
+  bool finished() const {
+    return next_ >= steps_.size() && waiting_ == 0 && !waiting_loaded_ && !waiting_exported_;
+  }
   bool empty() const { return steps_.empty(); }
 
  private:
@@ -66,6 +82,7 @@ class ScriptRunner {
   size_t next_ = 0;
   uint32_t waiting_ = 0;
   bool waiting_loaded_ = false;
+  bool waiting_exported_ = false;
 };
 
 }  // namespace fibscope

@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "app/viewer/dissection.h"
+#include "render/camera.h"
 #include "render/render_settings.h"
 
 namespace fibscope {
@@ -101,6 +103,13 @@ struct ViewerState {
   std::vector<LoadFailure> load_failures;
   std::vector<std::string> recent_files;  // newest first (recent_files.h)
   SelectionInfo selection;
+  // The virtual dissection (dissection.h): ROIs, cuts, the kept count.
+  DissectionState dissection;
+  // The camera of the last frame drawn (the window's size) and the box of
+  // every loaded model: the dissection panel places ROIs and clip planes
+  // at the focal point and draws the ROIs' outlines with them.
+  Camera camera;
+  Bounds scene_bounds;
   AnatomyInfo anatomy;
   std::string anatomy_path;  // the anatomy panel's path entry
   // Every visible model is drawn; with a baseline pipeline (lines,
@@ -125,6 +134,9 @@ struct ViewerState {
   bool show_performance = true;
   bool show_models = true;
   bool show_selection = true;
+  // Opened by the frame loop when the dissection gets its first ROI or
+  // plane (as the selection panel appears with a selection).
+  bool show_dissection = false;
   bool show_anatomy = true;
   std::string screenshot_path = "fibscope.png";  // the screenshot button's file
   std::string open_path;                         // the models panel's path entry

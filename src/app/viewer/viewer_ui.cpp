@@ -193,6 +193,7 @@ std::vector<ViewerAction> drawViewerUi(ViewerState& state) {
       ImGui::MenuItem("Render settings", nullptr, &state.show_settings);
       ImGui::MenuItem("Performance", nullptr, &state.show_performance);
       ImGui::MenuItem("Selection", nullptr, &state.show_selection);
+      ImGui::MenuItem("Dissection", nullptr, &state.show_dissection);
       ImGui::MenuItem("Anatomy", nullptr, &state.show_anatomy);
       ImGui::EndMenu();
     }
@@ -204,6 +205,8 @@ std::vector<ViewerAction> drawViewerUi(ViewerState& state) {
   if (state.show_settings) settingsPanel(state, actions);
   if (state.show_performance) performanceOverlay(state);
   if (state.show_selection) drawSelectionPanel(state, actions);
+  drawDissectionOverlay(state);
+  if (state.show_dissection) drawDissectionPanel(state, actions);
   if (state.show_anatomy) drawAnatomyPanel(state, actions);
   statusLine(state);
   return actions;

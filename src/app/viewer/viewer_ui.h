@@ -33,6 +33,12 @@ void drawLoadingOverlay(const ViewerState& state);
 // shown while something is selected.
 void drawSelectionPanel(ViewerState& state, std::vector<ViewerAction>& actions);
 
+// viewer_ui_dissection.cpp: the dissection panel (ROIs, length limits, the
+// kept count, hide or dim, clip planes and slab, ROI set files, export of
+// the kept fibers, the mouse bindings) and the ROIs' outlines over the
+// scene (drawn whether the panel is open or not).
+void drawDissectionPanel(ViewerState& state, std::vector<ViewerAction>& actions);
+void drawDissectionOverlay(const ViewerState& state);
 // viewer_ui_anatomy.cpp: the anatomy panel (the image's path entry, its
 // grid and values, the slices with sliders over its voxels, the display
 // range, opacity, sampling, the slab following the active slice).

@@ -143,6 +143,9 @@ void ViewerWindow::onScroll(GLFWwindow* window, double dx, double dy) {
   e.type = InputEvent::Type::Scroll;
   e.x = dx;
   e.y = dy;
+  // GLFW gives the wheel no modifiers: shift + wheel resizes a ROI.
+  e.shift =
+      glfwGetKey(window, GLFW_KEY_LEFT_SHIFT) == GLFW_PRESS || glfwGetKey(window, GLFW_KEY_RIGHT_SHIFT) == GLFW_PRESS;
   from(window).events_.push_back(std::move(e));
 }
 

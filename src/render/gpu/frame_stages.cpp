@@ -7,6 +7,8 @@ FrameStageList shadingStages() { return {makeTilesStage, makeSsaoStage, makeShad
 FrameStageList standardFrameStages() {
   FrameStageList list = {
       makeSetupStage,
+      // Before any geometry: the depths the rasters and the cull read.
+      makeCutMeshStage,
       // Geometry: the lines' G-buffer (one of them runs).
       makeFibletStage,
       makeRawComputeStage,

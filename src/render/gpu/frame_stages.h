@@ -15,6 +15,8 @@ std::unique_ptr<FrameStage> makeSetupStage(const gpu::VulkanContext& context);
 // "fiblet bounds", "cull"/"raster" (or the two-phase passes), "resolve":
 // the compute pipeline over the scene's datasets (cull_passes.h,
 // fiblet_passes.h).
+// Mesh cuts: each cut mesh's front and back depths (shared/cut_mesh.h).
+std::unique_ptr<FrameStage> makeCutMeshStage(const gpu::VulkanContext& context);
 std::unique_ptr<FrameStage> makeFibletStage(const gpu::VulkanContext& context);
 // "raster", "resolve": the raw-compute baseline (raw_passes.h).
 std::unique_ptr<FrameStage> makeRawComputeStage(const gpu::VulkanContext& context);

@@ -5,6 +5,7 @@
 
 #include <vector>
 
+#include "render/gpu/cut_mesh.h"
 #include "render/gpu/dataset.h"
 #include "render/gpu/raw_tractogram.h"
 #include "shared/surface_push.h"
@@ -44,6 +45,14 @@ struct GpuScene {
   // all (no pixel, no pick).
   VkDeviceAddress kept_bits = 0;
   VkDeviceAddress kept_point_bits = 0;
+  // Mesh cuts (shared/cut_mesh.h), at most shader::kMaxCutMeshes: each
+  // closed mesh hides the fiber fragments inside it (cull_inside) or
+  // outside it, in every pipeline; fiblets it hides wholly are culled.
+  struct CutMesh {
+    const GpuCutMesh* mesh = nullptr;
+    bool cull_inside = true;
+  };
+  std::vector<CutMesh> cut_meshes;
   // Analytic spheres (world mm) drawn as surfaces with the lines, at most
   // shader::kMaxSurfaceSpheres; their ids land in the G-buffer's fiber field.
   std::vector<shader::SurfaceSphere> spheres;

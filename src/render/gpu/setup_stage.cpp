@@ -24,7 +24,8 @@ class SetupStage final : public FrameStage {
     // Everything after reads or accumulates into these: compute passes,
     // and the lines pipeline's vertex shader (the camera block).
     const gpu::PassBarrier after{VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                                 VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT,
+                                 VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT |
+                                     VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
                                  gpu::kStorageReadWrite};
     gpu::PassScope pass(frame.cmd, frame.timer, "clear", after);
     const shader::CameraBlock block =

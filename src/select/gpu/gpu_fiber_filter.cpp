@@ -47,8 +47,10 @@ std::string signatureOf(const FiberFilter& filter, const std::string& sources) {
     s += '|';
     for (const Region& r : *list) s += regionSpec(r) + ';';
   }
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "|%d|%a|%a", int(c.ends_only), double(filter.minLength()), double(filter.maxLength()));
+  if (c.distance_zone) s += "|zone " + regionSpec(*c.distance_zone);
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "|%d|%a|%a|%a", int(c.ends_only), double(filter.minLength()), double(filter.maxLength()),
+                double(filter.maxZoneDistance2()));
   return s + buf;
 }
 
@@ -76,7 +78,7 @@ void GpuFiberFilter::release() {
   for (gpu::ComputePipeline* p : {&fiblet_hits_, &fiblet_ordered_, &raw_hits_, &raw_points_, &combine_})
     gpu::destroyComputePipeline(context_, *p);
   gpu::destroyGpuTimer(context_, timer_);
-  for (gpu::Buffer* b : {&regions_, &hits_, &kept_, &point_bits_}) gpu::destroyBuffer(context_, *b);
+  for (gpu::Buffer* b : {&regions_, &hits_, &kept_, &point_bits_, &zone_d2_, &zone_mm_}) gpu::destroyBuffer(context_, *b);
   for (gpu::Buffer& b : masks_) gpu::destroyBuffer(context_, b);
   masks_.clear();
 }
@@ -122,6 +124,13 @@ void GpuFiberFilter::prepare(const FiberFilter& filter, uint32_t scene_fibers, u
   push.hit_regions = uint32_t(packed.regions.size());
   for (const Region& r : c.include_ordered) pack(r);
   push.ordered_regions = uint32_t(c.include_ordered.size());
+  has_zone_ = filter.zone() != nullptr;
+  if (has_zone_) {
+    packed.regions.push_back(*filter.zone());
+    push.has_zone = 1;
+    push.max_d2 = filter.maxZoneDistance2();
+    push.zone_radius = filter.zone()->kind == shader::kFilterSphere ? filter.zone()->v[3] : 0.0f;
+  }
   push.ends_only = c.ends_only ? 1u : 0u;
   push.min_length = filter.minLength();
   push.max_length = filter.maxLength();
@@ -133,6 +142,10 @@ void GpuFiberFilter::prepare(const FiberFilter& filter, uint32_t scene_fibers, u
     ensureBuffer(context_, hits_, uint64_t(scene_fibers) * 16, gpu::MemoryUse::DeviceLocal);
     ensureBuffer(context_, kept_, selectionWords(scene_fibers) * 4, gpu::MemoryUse::DeviceLocal);
     if (points > 0) ensureBuffer(context_, point_bits_, selectionWords(points) * 4, gpu::MemoryUse::DeviceLocal);
+    if (has_zone_) {
+      ensureBuffer(context_, zone_d2_, uint64_t(scene_fibers) * 4, gpu::MemoryUse::DeviceLocal);
+      ensureBuffer(context_, zone_mm_, uint64_t(scene_fibers) * 4, gpu::MemoryUse::DeviceLocal);
+    }
   } catch (...) {
     clear();
     throw;
@@ -141,6 +154,8 @@ void GpuFiberFilter::prepare(const FiberFilter& filter, uint32_t scene_fibers, u
   push.hits = hits_.address;
   push.kept = kept_.address;
   push.point_bits = point_bits_.address;
+  push.zone_d2 = zone_d2_.address;
+  push.zone_mm = zone_mm_.address;
 }
 
 
@@ -161,7 +176,7 @@ bool GpuFiberFilter::update(const FiberFilter& filter, std::span<const FilterFib
     return false;
   }
   fibers_ = scene_fibers;
-  if (filter.criteria().empty() || scene_fibers == 0) {
+  if ((filter.criteria().empty() && !filter.zone()) || scene_fibers == 0) {
     clear();
     signature_ = signature;
     return true;
@@ -172,12 +187,15 @@ bool GpuFiberFilter::update(const FiberFilter& filter, std::span<const FilterFib
     gpu::resetGpuTimer(cmd, timer_);
     vkCmdFillBuffer(cmd, hits_.buffer, 0, VK_WHOLE_SIZE, 0);
     vkCmdFillBuffer(cmd, kept_.buffer, 0, VK_WHOLE_SIZE, 0);
+    if (has_zone_) vkCmdFillBuffer(cmd, zone_d2_.buffer, 0, VK_WHOLE_SIZE, 0x7F800000u);  // +inf
     gpu::recordBarrier(cmd, gpu::kTransferToCompute);
     gpu::PassScope pass(cmd, &timer_, "filter", gpu::kNoBarrier);
     auto dispatch = [&](const gpu::ComputePipeline& pipeline, const FilterFibletSource& src, uint64_t items) {
       shader::FilterPassPush push = packed.push;
       push.source = src.block;
       push.hits = hits_.address + uint64_t(src.fiber_base) * 16;
+      push.zone_d2 = zone_d2_.address + uint64_t(src.fiber_base) * 4;
+      push.zone_mm = zone_mm_.address + uint64_t(src.fiber_base) * 4;
       push.lengths = src.lengths;
       push.fiber_count = src.fibers;
       push.fiber_base = src.fiber_base;
@@ -207,7 +225,7 @@ bool GpuFiberFilter::update(const FiberFilter& filter, const FilterRawSource& ra
     return false;
   }
   fibers_ = raw.streamlines;
-  if (filter.criteria().empty() || raw.streamlines == 0) {
+  if ((filter.criteria().empty() && !filter.zone()) || raw.streamlines == 0) {
     clear();
     signature_ = signature;
     return true;
@@ -243,6 +261,13 @@ void GpuFiberFilter::finish() {
   last_ms_ = times.empty() ? 0 : times.front().ms;
   kept_count_ = 0;
   for (uint32_t w : keptWords()) kept_count_ += uint64_t(std::popcount(w));
+}
+
+std::vector<float> GpuFiberFilter::zoneDistanceValues() const {
+  if (!active_ || !has_zone_) return {};
+  std::vector<float> values(fibers_);
+  gpu::downloadFromBuffer(context_, zone_mm_, values.data(), values.size() * sizeof(float));
+  return values;
 }
 
 std::vector<uint32_t> GpuFiberFilter::keptWords() const {

@@ -80,6 +80,11 @@ class GpuFiberFilter {
   uint32_t fiberCount() const { return fibers_; }
   // The kept words of the last update (downloaded), or empty with no criteria.
   std::vector<uint32_t> keptWords() const;
+  // With a distance zone (FilterCriteria::distance_zone): each fiber's
+  // smallest distance to it, mm (float per scene fiber: a ColorMode::Scalar
+  // source); 0 otherwise.
+  VkDeviceAddress zoneDistances() const { return active_ && has_zone_ ? zone_mm_.address : 0; }
+  std::vector<float> zoneDistanceValues() const;  // downloaded; empty without a zone
   // GPU time of the last update's passes (ms), 0 when it did no work.
   double lastGpuMilliseconds() const { return last_ms_; }
 
@@ -92,7 +97,8 @@ class GpuFiberFilter {
   const gpu::VulkanContext& context_;
   gpu::ComputePipeline fiblet_hits_, fiblet_ordered_, raw_hits_, raw_points_, combine_;
   gpu::GpuTimer timer_;
-  gpu::Buffer regions_, hits_, kept_, point_bits_;
+  gpu::Buffer regions_, hits_, kept_, point_bits_, zone_d2_, zone_mm_;
+  bool has_zone_ = false;
   std::vector<gpu::Buffer> masks_;  // the voxel bits of mask regions
   std::string signature_;           // criteria and sources of the last update
   bool active_ = false, raw_ = false;

@@ -1,0 +1,362 @@
+// The dissection panel (dissection.h): the ROIs with their roles, placed at
+// the focal point and edited numerically; ends only and length limits; the
+// kept count and how dropped fibers are shown; clip planes and the slab;
+// saving and loading the ROI set; exporting the kept fibers. And the ROIs'
+// outlines over the scene, so that the mouse has something to aim at.
+#include <imgui.h>
+#include <imgui_stdlib.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <glm/glm.hpp>
+#include <string>
+
+#include "app/viewer/viewer_ui.h"
+#include "core/error.h"
+
+namespace fibscope {
+namespace {
+
+const ImVec4 kWarning(1.0f, 0.8f, 0.3f, 1.0f);
+const ImVec4 kError(1.0f, 0.45f, 0.4f, 1.0f);
+
+const char* const kRoleNames[] = {"include", "exclude", "ordered"};
+
+ImU32 roleColor(RoiRole role, bool enabled, bool selected) {
+  if (!enabled) return selected ? IM_COL32(200, 200, 200, 255) : IM_COL32(130, 130, 130, 160);
+  const int a = selected ? 255 : 190;
+  switch (role) {
+    case RoiRole::Include:
+      return IM_COL32(90, 230, 120, a);
+    case RoiRole::Exclude:
+      return IM_COL32(240, 90, 80, a);
+    case RoiRole::IncludeOrdered:
+      return IM_COL32(80, 200, 240, a);
+  }
+  return IM_COL32(255, 255, 255, a);
+}
+
+glm::dvec3 focalPoint(const ViewerState& state) {
+  return {state.camera.target[0], state.camera.target[1], state.camera.target[2]};
+}
+
+bool dragDouble3(const char* label, glm::dvec3& v, float speed, double min = -1e6, double max = 1e6) {
+  return ImGui::DragScalarN(label, ImGuiDataType_Double, &v.x, 3, speed, &min, &max, "%.1f");
+}
+
+// The selected ROI's geometry, by kind; true when it changed.
+bool regionEditor(Region& region) {
+  if (auto* s = std::get_if<SphereRegion>(&region)) {
+    bool changed = ImGui::DragFloat3("centre (mm)", s->center.data(), 0.25f, -1e6f, 1e6f, "%.1f");
+    changed |= ImGui::DragFloat("radius (mm)", &s->radius, 0.1f, 0.1f, 1e4f, "%.1f", ImGuiSliderFlags_AlwaysClamp);
+    return changed;
+  }
+  if (auto* b = std::get_if<BoxRegion>(&region)) {
+    glm::dvec3 lo(b->min[0], b->min[1], b->min[2]), hi(b->max[0], b->max[1], b->max[2]);
+    glm::dvec3 center = 0.5 * (lo + hi), size = hi - lo;
+    bool changed = dragDouble3("centre (mm)", center, 0.25f);
+    changed |= dragDouble3("size (mm)", size, 0.25f, 0.0, 1e5);
+    if (changed)
+      for (int k = 0; k < 3; ++k) {
+        b->min[k] = center[k] - size[k] / 2;
+        b->max[k] = center[k] + size[k] / 2;
+      }
+    return changed;
+  }
+  if (auto* o = std::get_if<OrientedBoxRegion>(&region)) {
+    glm::dvec3 center(o->center[0], o->center[1], o->center[2]);
+    glm::dvec3 size(2 * o->half[0], 2 * o->half[1], 2 * o->half[2]);
+    glm::dvec3 angles(o->angles_deg[0], o->angles_deg[1], o->angles_deg[2]);
+    bool changed = dragDouble3("centre (mm)", center, 0.25f);
+    changed |= dragDouble3("size (mm)", size, 0.25f, 0.01, 1e5);
+    changed |= dragDouble3("angles (deg)", angles, 0.5f, -360.0, 360.0);
+    if (changed) {
+      try {
+        *o = orientedBox(center, size, angles);
+      } catch (const Error&) {
+        return false;  // a size dragged to 0: the box stays as it was
+      }
+    }
+    return changed;
+  }
+  ImGui::TextDisabled("%s", regionSpec(region).c_str());  // a mask: its file, not edited here
+  return false;
+}
+
+void roiList(ViewerState& state) {
+  DissectionState& d = state.dissection;
+  RoiSet& set = d.set;
+  const double radius = defaultRoiRadius(state.scene_bounds);
+  if (ImGui::Button("+ sphere")) {
+    Roi roi{uniqueRoiName(set, "sphere"), sphereAt(focalPoint(state), radius), RoiRole::Include, true};
+    set.rois.push_back(std::move(roi));
+    d.selected = int(set.rois.size()) - 1;
+  }
+  ImGui::SameLine();
+  if (ImGui::Button("+ box")) {
+    set.rois.push_back(Roi{uniqueRoiName(set, "box"), boxAt(focalPoint(state), radius), RoiRole::Include, true});
+    d.selected = int(set.rois.size()) - 1;
+  }
+  ImGui::SameLine();
+  ImGui::TextDisabled("at the focal point");
+
+  int remove = -1;
+  if (!set.rois.empty() &&
+      ImGui::BeginTable("rois", 4,
+                        ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersOuter | ImGuiTableFlags_SizingFixedFit)) {
+    ImGui::TableSetupColumn("on");
+    ImGui::TableSetupColumn("name", ImGuiTableColumnFlags_WidthStretch);
+    ImGui::TableSetupColumn("role");
+    ImGui::TableSetupColumn("");
+    ImGui::TableHeadersRow();
+    for (size_t i = 0; i < set.rois.size(); ++i) {
+      Roi& roi = set.rois[i];
+      ImGui::PushID(int(i));
+      ImGui::TableNextRow();
+      ImGui::TableNextColumn();
+      ImGui::Checkbox("##on", &roi.enabled);
+      ImGui::TableNextColumn();
+      ImGui::PushStyleColor(ImGuiCol_Text, ImGui::ColorConvertU32ToFloat4(roleColor(roi.role, true, false)));
+      if (ImGui::Selectable(roi.name.empty() ? "(unnamed)" : roi.name.c_str(), d.selected == int(i)))
+        d.selected = d.selected == int(i) ? -1 : int(i);
+      ImGui::PopStyleColor();
+      ImGui::TableNextColumn();
+      int role = int(roi.role);
+      ImGui::SetNextItemWidth(90);
+      if (ImGui::Combo("##role", &role, kRoleNames, 3)) roi.role = RoiRole(role);
+      if (ImGui::IsItemHovered()) ImGui::SetTooltip("ordered: include regions entered in their list order");
+      ImGui::TableNextColumn();
+      if (ImGui::SmallButton("x")) remove = int(i);
+      ImGui::PopID();
+    }
+    ImGui::EndTable();
+  }
+  if (remove >= 0) {
+    set.rois.erase(set.rois.begin() + remove);
+    if (d.selected == remove)
+      d.selected = -1;
+    else if (d.selected > remove)
+      --d.selected;
+  }
+  if (d.selected >= 0 && d.selected < int(set.rois.size())) {
+    Roi& roi = set.rois[size_t(d.selected)];
+    ImGui::PushID("selected");
+    ImGui::InputText("name", &roi.name);
+    regionEditor(roi.region);
+    ImGui::PopID();
+  }
+}
+
+void lengthLimit(const char* label, double& value, double fallback) {
+  bool on = !std::isnan(value);
+  ImGui::PushID(label);
+  if (ImGui::Checkbox(label, &on)) value = on ? fallback : NAN;
+  if (on) {
+    ImGui::SameLine();
+    ImGui::SetNextItemWidth(-1);
+    const double lo = 0, hi = 1e4;
+    ImGui::DragScalar("##mm", ImGuiDataType_Double, &value, 0.5f, &lo, &hi, "%.1f mm", ImGuiSliderFlags_AlwaysClamp);
+  }
+  ImGui::PopID();
+}
+
+void cutsSection(ViewerState& state) {
+  RoiSet& set = state.dissection.set;
+  const bool room = enabledClipPlanes(set) < kMaxClipPlanes;
+  if (!room) ImGui::BeginDisabled();
+  if (ImGui::Button("+ clip plane")) set.clip_planes.push_back(RoiClipPlane{planeFacingViewer(state.camera), true});
+  if (!room) ImGui::EndDisabled();
+  ImGui::SameLine();
+  ImGui::TextDisabled(room ? "at the focal point, facing you" : "at most 6 enabled");
+  int remove = -1;
+  for (size_t i = 0; i < set.clip_planes.size(); ++i) {
+    RoiClipPlane& p = set.clip_planes[i];
+    ImGui::PushID(int(i));
+    bool enabled = p.enabled;
+    if (ImGui::Checkbox("##on", &enabled) && (!enabled || room)) p.enabled = enabled;
+    ImGui::SameLine();
+    ImGui::Text("plane %zu", i + 1);
+    ImGui::SameLine();
+    if (ImGui::SmallButton("flip")) p.plane.normal = -p.plane.normal;
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("keep the other side");
+    ImGui::SameLine();
+    if (ImGui::SmallButton("x")) remove = int(i);
+    ImGui::DragFloat3("point (mm)", &p.plane.point.x, 0.25f, -1e6f, 1e6f, "%.1f");
+    glm::vec3 n = p.plane.normal;
+    if (ImGui::DragFloat3("normal", &n.x, 0.01f, -1.0f, 1.0f, "%.2f") && glm::length(n) > 1e-4f)
+      p.plane.normal = glm::normalize(n);  // kept unit; a zero normal is refused
+    ImGui::PopID();
+  }
+  if (remove >= 0) set.clip_planes.erase(set.clip_planes.begin() + remove);
+
+  RenderSettings& s = state.settings;
+  ImGui::SliderFloat("slab", &s.slab_mm, 0.0f, 200.0f, s.slab_mm > 0 ? "%.1f mm" : "off", ImGuiSliderFlags_AlwaysClamp);
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("draw only this thick a slab around the focal plane (moves with the view)");
+  if (set.slab && !set.slab->follow.empty())
+    ImGui::TextColored(kWarning, "the set's slab follows the %s slice: drawn about the focal plane for now",
+                       set.slab->follow.c_str());
+  if (!set.cut_meshes.empty() || !set.anatomy.empty())
+    ImGui::TextDisabled("%zu cut mesh(es)%s kept in the set, not drawn here yet", set.cut_meshes.size(),
+                        set.anatomy.empty() ? "" : " and the anatomy");
+}
+
+void filesSection(ViewerState& state, std::vector<ViewerAction>& actions) {
+  DissectionState& d = state.dissection;
+  ImGui::SetNextItemWidth(-120);
+  ImGui::InputTextWithHint("##set", "dissection.json", &d.roi_set_path);
+  ImGui::SameLine();
+  if (ImGui::Button("Save") && !d.roi_set_path.empty()) actions.push_back(RoiSetFileAction{true, d.roi_set_path});
+  ImGui::SameLine();
+  if (ImGui::Button("Load") && !d.roi_set_path.empty()) actions.push_back(RoiSetFileAction{false, d.roi_set_path});
+  if (!d.file_message.empty()) ImGui::TextWrapped("%s", d.file_message.c_str());
+
+  ImGui::SetNextItemWidth(-120);
+  ImGui::InputTextWithHint("##export", "kept.tck", &d.export_path);
+  ImGui::SameLine();
+  if (d.exporting) ImGui::BeginDisabled();
+  if (ImGui::Button("Export kept") && !d.export_path.empty()) actions.push_back(ExportKeptAction{d.export_path});
+  if (d.exporting) ImGui::EndDisabled();
+  if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+    ImGui::SetTooltip(
+        "The active model's source file through the filter, as `fibscope filter IN OUT` with these "
+        "criteria writes it (.tck, .trk, .trx; a .trx gets a group per ROI)");
+  if (d.exporting) {
+    ImGui::SameLine();
+    ImGui::TextColored(kWarning, "exporting...");
+  }
+}
+
+}  // namespace
+
+void drawDissectionPanel(ViewerState& state, std::vector<ViewerAction>& actions) {
+  const ImGuiViewport* viewport = ImGui::GetMainViewport();
+  // The right column under the performance overlay, down to the bottom.
+  const float top = std::min(360.0f, viewport->WorkSize.y * 0.45f);
+  ImGui::SetNextWindowPos(ImVec2(viewport->WorkPos.x + viewport->WorkSize.x - 10, viewport->WorkPos.y + top),
+                          ImGuiCond_FirstUseEver, ImVec2(1, 0));
+  ImGui::SetNextWindowSize(ImVec2(340, std::max(120.0f, viewport->WorkSize.y - top - 10)), ImGuiCond_FirstUseEver);
+  if (!ImGui::Begin("Dissection", &state.show_dissection)) {
+    ImGui::End();
+    return;
+  }
+  DissectionState& d = state.dissection;
+  const DissectionStats& stats = d.stats;
+  if (!stats.error.empty()) {
+    ImGui::TextColored(kError, "%s", stats.error.c_str());
+  } else if (stats.active) {
+    ImGui::Text("kept %llu of %llu fibers", static_cast<unsigned long long>(stats.kept),
+                static_cast<unsigned long long>(stats.fibers));
+    ImGui::SameLine();
+    if (!stats.evaluated)
+      ImGui::TextColored(kWarning, "updating...");
+    else
+      ImGui::TextDisabled("(%.0f ms)", stats.update_ms);
+  } else {
+    ImGui::TextDisabled("no criteria: all %llu fibers kept", static_cast<unsigned long long>(stats.fibers));
+  }
+  int dim = d.dim_dropped ? 1 : 0;
+  ImGui::TextUnformatted("dropped fibers:");
+  ImGui::SameLine();
+  ImGui::RadioButton("hide", &dim, 0);
+  ImGui::SameLine();
+  ImGui::RadioButton("dim", &dim, 1);
+  d.dim_dropped = dim == 1;
+  if (d.dim_dropped && !state.selection.fibers.empty())
+    ImGui::TextDisabled("(the picked selection is not highlighted while dimming)");
+
+  if (ImGui::CollapsingHeader("Regions", ImGuiTreeNodeFlags_DefaultOpen)) {
+    roiList(state);
+    ImGui::Checkbox("ends only", &d.set.ends_only);
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("test only the first and last point of each fiber");
+    lengthLimit("min length", d.set.min_length_mm, 20.0);
+    lengthLimit("max length", d.set.max_length_mm, 250.0);
+    if (!std::isnan(d.set.min_length_mm) && !std::isnan(d.set.max_length_mm) &&
+        d.set.min_length_mm > d.set.max_length_mm)
+      d.set.max_length_mm = d.set.min_length_mm;
+  }
+  if (ImGui::CollapsingHeader("Cuts", ImGuiTreeNodeFlags_DefaultOpen)) cutsSection(state);
+  if (ImGui::CollapsingHeader("Files", ImGuiTreeNodeFlags_DefaultOpen)) filesSection(state, actions);
+  if (ImGui::CollapsingHeader("Mouse")) {
+    ImGui::TextWrapped(
+        "right click: a sphere at the fiber under the cursor (on the focal plane over the background)\n"
+        "right drag: move the selected ROI in the view plane\n"
+        "shift + wheel, ] and [: resize the selected ROI\n"
+        "Delete: remove the selected ROI\n"
+        "(left drag orbits, middle or shift + left drag pans, click picks fibers)");
+  }
+  ImGui::End();
+}
+
+void drawDissectionOverlay(const ViewerState& state) {
+  const DissectionState& d = state.dissection;
+  if (d.set.rois.empty() || state.camera.width == 0 || state.camera.height == 0) return;
+  const std::array<double, 16> m = viewProjectionD(state.camera);
+  const ImVec2 scale = ImGui::GetIO().DisplayFramebufferScale;
+  // World mm -> ImGui's coordinates (framebuffer pixels over the scale);
+  // false behind the eye.
+  auto project = [&](const glm::dvec3& p, ImVec2& out) {
+    const double x = m[0] * p.x + m[4] * p.y + m[8] * p.z + m[12];
+    const double y = m[1] * p.x + m[5] * p.y + m[9] * p.z + m[13];
+    const double w = m[3] * p.x + m[7] * p.y + m[11] * p.z + m[15];
+    if (!(w > 1e-6)) return false;
+    out = ImVec2(float((x / w + 1) * 0.5 * state.camera.width / std::max(scale.x, 1e-3f)),
+                 float((y / w + 1) * 0.5 * state.camera.height / std::max(scale.y, 1e-3f)));
+    return true;
+  };
+  const glm::dvec3 eye(state.camera.eye[0], state.camera.eye[1], state.camera.eye[2]);
+  const glm::dvec3 forward =
+      glm::normalize(glm::dvec3(state.camera.target[0], state.camera.target[1], state.camera.target[2]) - eye);
+  const double px_per_mm_at_unit =
+      state.camera.height / std::max(scale.y, 1e-3f) / (2 * std::tan(glm::radians(state.camera.fov_y_deg) / 2));
+  ImDrawList* draw = ImGui::GetBackgroundDrawList();
+  for (size_t i = 0; i < d.set.rois.size(); ++i) {
+    const Roi& roi = d.set.rois[i];
+    const bool selected = int(i) == d.selected;
+    const ImU32 color = roleColor(roi.role, roi.enabled, selected);
+    const float thickness = selected ? 2.5f : 1.5f;
+    ImVec2 label_at;
+    bool labelled = false;
+    if (const auto* s = std::get_if<SphereRegion>(&roi.region)) {
+      const glm::dvec3 c(s->center[0], s->center[1], s->center[2]);
+      const double depth = glm::dot(c - eye, forward);
+      ImVec2 at;
+      if (depth <= 1e-3 || !project(c, at)) continue;
+      const float r = float(double(s->radius) * px_per_mm_at_unit / depth);
+      draw->AddCircle(at, r, color, 48, thickness);
+      label_at = ImVec2(at.x + r * 0.72f, at.y - r * 0.72f);
+      labelled = true;
+    } else if (std::holds_alternative<BoxRegion>(roi.region) || std::holds_alternative<OrientedBoxRegion>(roi.region)) {
+      // The 8 corners (bit k of the index: the +half side of axis k).
+      glm::dvec3 center, axes[3];
+      if (const auto* b = std::get_if<BoxRegion>(&roi.region)) {
+        center = 0.5 * (glm::dvec3(b->min[0], b->min[1], b->min[2]) + glm::dvec3(b->max[0], b->max[1], b->max[2]));
+        for (int k = 0; k < 3; ++k) {
+          axes[k] = glm::dvec3(0);
+          axes[k][k] = 0.5 * (b->max[k] - b->min[k]);
+        }
+      } else {
+        const auto& o = std::get<OrientedBoxRegion>(roi.region);
+        center = glm::dvec3(o.center[0], o.center[1], o.center[2]);
+        for (int k = 0; k < 3; ++k) axes[k] = o.half[k] * glm::dvec3(o.axes[k][0], o.axes[k][1], o.axes[k][2]);
+      }
+      ImVec2 corner[8];
+      bool visible = true;
+      for (int c = 0; c < 8 && visible; ++c) {
+        glm::dvec3 p = center;
+        for (int k = 0; k < 3; ++k) p += ((c >> k) & 1 ? 1.0 : -1.0) * axes[k];
+        visible = project(p, corner[c]);
+      }
+      if (!visible) continue;
+      for (int c = 0; c < 8; ++c)
+        for (int k = 0; k < 3; ++k)
+          if (!((c >> k) & 1)) draw->AddLine(corner[c], corner[c | (1 << k)], color, thickness);
+      label_at = corner[7];
+      labelled = true;
+    }
+    if (labelled && !roi.name.empty()) draw->AddText(label_at, color, roi.name.c_str());
+  }
+}
+
+}  // namespace fibscope
