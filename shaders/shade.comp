@@ -28,6 +28,7 @@ layout(local_size_x_id = WORKGROUP_SIZE_X_ID, local_size_y_id = WORKGROUP_SIZE_Y
 layout(constant_id = kShadeSpecColorMode) const uint COLOR_MODE = kShadeColorOrientation;
 layout(constant_id = kShadeSpecLighting) const uint LIGHTING = kShadeLightingIlluminated;
 layout(constant_id = kShadeSpecSurfaces) const bool SURFACES = false;
+layout(constant_id = kShadeSpecTranslucentSlices) const bool TRANSLUCENT_SLICES = false;
 
 layout(push_constant, std430) uniform Push { ShadePush pc; };
 
@@ -44,6 +45,7 @@ uint packRgba8(vec3 c) {
 }
 
 vec3 unpackRgb8(uint c) { return vec3(c & 255u, (c >> 8) & 255u, (c >> 16) & 255u) / 255.0; }
+float alpha8(uint c) { return float(c >> 24) / 255.0; }
 
 // The colormap entry of fiber scalar s (colormap.h: colormapIndex).
 vec3 scalarColor(ShadeBlockRef block, float s) {
@@ -85,15 +87,22 @@ void main() {
     const vec3 t = unpackTangent(texel.tangent);
     const vec3 v = pixelToEye(cam, p);
     // A surface's normal and own colour (shared/gbuffer.h).
-    bool surface = false;
+    bool surface = false, slice = false;
     vec3 n = vec3(0.0);
     uint own_color = 0u;
     if (SURFACES && (texel.segment & kGBufferSurface) != 0u) {
       const SurfaceTexel s = SurfaceRef(pc.surface).texels[index];
       surface = true;
+      slice = s.source == kSurfaceSourceSlice;
       n = unpackTangent(s.normal);
       if (dot(n, v) < 0.0) n = -n;
       own_color = s.color;
+    }
+    if (slice) {
+      // Anatomy shows its window/level grey as is: no lighting, no
+      // occlusion; a translucent one over the background.
+      ColorRef(pc.color).values[index] = packRgba8(mix(background, unpackRgb8(own_color), alpha8(own_color)));
+      return;
     }
     const bool known = texel.fiber < block.b.fiber_count;
     bool selected = false, dimmed = false;
@@ -127,6 +136,12 @@ void main() {
     }
     if (pc.ao != 0ul) c *= AoRef(pc.ao).values[index];
     if (dimmed) c = mix(c, background, block.b.dim_unselected);
+    if (TRANSLUCENT_SLICES) {
+      // A translucent slice in front (the merge left the pixel's texel).
+      const SurfaceTexel front = SurfaceRef(pc.surface).texels[index];
+      if (front.source == kSurfaceSourceSlice && front.depth < texel.depth)
+        c = mix(clamp(c, 0.0, 1.0), unpackRgb8(front.color), alpha8(front.color));  // over what is shown
+    }
   }
   ColorRef(pc.color).values[index] = packRgba8(c);
 }

@@ -42,7 +42,10 @@ void main() {
   GBufferRef gbuffer = GBufferRef(pc.gbuffer);
   const GBufferTexel centre = gbuffer.texels[index];
   float ao = 1.0;
-  if (centre.fiber != kNoFiberId && pc.radius_px > 0.0 && pc.strength > 0.0) {
+  // Anatomical slices (kNoFiberObject) take no occlusion (shade shows their
+  // grey as is) and cast none: a fiber behind a translucent slice is not
+  // darkened by it.
+  if (centre.fiber != kNoFiberId && centre.fiber != kNoFiberObject && pc.radius_px > 0.0 && pc.strength > 0.0) {
     const CameraBlock cam = CameraRef(pc.camera).camera;
     const float z = viewDistance(cam, centre.depth);
     // A 4 x 4 Bayer matrix: consecutive angles as far apart in the tile as
@@ -63,7 +66,7 @@ void main() {
         const ivec2 q = ivec2(floor(vec2(p) + 0.5 + r * vec2(cos(a), sin(a))));
         if (q.x < 0 || q.y < 0 || q.x >= int(pc.width) || q.y >= int(pc.height)) continue;
         const GBufferTexel t = gbuffer.texels[uint(q.y) * pc.width + uint(q.x)];
-        if (t.fiber == kNoFiberId || t.fiber == centre.fiber) continue;
+        if (t.fiber == kNoFiberId || t.fiber == kNoFiberObject || t.fiber == centre.fiber) continue;
         const float nearer = z - viewDistance(cam, t.depth);
         if (nearer > pc.epsilon_mm && nearer < pc.range_mm)
           occluded += weight * (1.0 - smoothstep(0.5 * pc.range_mm, pc.range_mm, nearer));

@@ -2,7 +2,8 @@
 // strictly nearer than the lines' replaces the lines' texel, marked as a
 // surface's (kGBufferSurface | source), so that shading, SSAO and picking
 // read one G-buffer whatever drew the lines (compute, raw-compute, lines)
-// and whatever drew the surfaces.
+// and whatever drew the surfaces. A translucent slice (alpha < 255) over a
+// drawn pixel leaves it: the shade pass blends the slice over it.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_buffer_reference : require
@@ -24,7 +25,9 @@ void main() {
   const uint index = p.y * pc.width + p.x;
   const SurfaceTexel s = SurfaceRef(pc.surface).texels[index];
   GBufferRef gbuffer = GBufferRef(pc.gbuffer);
-  if (!(s.depth < gbuffer.texels[index].depth)) return;
+  const GBufferTexel behind = gbuffer.texels[index];
+  if (!(s.depth < behind.depth)) return;
+  if (s.source == kSurfaceSourceSlice && (s.color >> 24) < 255u && behind.fiber != kNoFiberId) return;
   GBufferTexel texel;
   texel.depth = s.depth;
   texel.fiber = s.fiber;

@@ -81,6 +81,7 @@ struct TileClassifyPush {
 // Multi-scale (scales > 1): the same at radius_px * 2^k for k = 0 ..
 // scales - 1 (each scale's spiral turned by a further golden angle), and
 // ao = the product of the per-scale factors, so more scales never lighten.
+// Anatomical slices (fiber kNoFiberObject) take none (1) and cast none.
 struct SsaoPush {
   uint64_t camera;   // CameraBlock: depth_range linearises the clip depth
   uint64_t gbuffer;  // GBufferTexel per pixel
@@ -131,8 +132,13 @@ struct SsaoBlurPush {
 // and colour come from the surface target, N turned towards the eye) take
 // Blinn-Phong with the same light and coefficients instead:
 //   diffuse  = max(0, N.L), specular = max(0, N.H)^shininess, H = normalize(L + V)
-// and their own colour where its alpha is > 0 (a slice), else the colour
-// mode's (Normal: N itself).
+// and their own colour where its alpha is > 0, else the colour mode's
+// (Normal: N itself). Anatomical slices (kSurfaceSourceSlice) are not lit
+// and take no occlusion: their grey is the window/level's, blended over
+// the background by their alpha (1 for an opaque slice). With translucent
+// slices (kShadeSpecTranslucentSlices), a pixel whose surface texel is a
+// slice nearer than its G-buffer texel (which the merge kept) ends as
+// mix(its colour, the slice's grey, the slice's alpha).
 // Base colours: Scalar reads fiber_scalars[fiber] and the colormap table
 // (entry round(255 t), t = (s - scalar_min) / (scalar_max - scalar_min)
 // clamped, NaN -> 0, max == min -> 0.5); a fiber id >= fiber_count falls
@@ -145,6 +151,7 @@ struct SsaoBlurPush {
 SHADE_CONST uint kShadeSpecColorMode = 0u;  // constant_id: kShadeColor*
 SHADE_CONST uint kShadeSpecLighting = 1u;   // constant_id: kShadeLighting*
 SHADE_CONST uint kShadeSpecSurfaces = 2u;   // constant_id: 1 when the frame has surfaces
+SHADE_CONST uint kShadeSpecTranslucentSlices = 3u;  // constant_id: 1 when its slices are translucent
 struct ShadePush {
   uint64_t camera;
   uint64_t gbuffer;

@@ -3,6 +3,7 @@
 // the uint64_t members first, so std430 and C++ agree.
 //
 //   sphere_surface.comp  analytic spheres, ray-cast per pixel
+//   anatomy_slices.comp  anatomical slices (shared/anatomy.h)
 //   surface_merge.comp   surface pixels nearer than the lines -> G-buffer
 #ifndef FIBSCOPE_SHADERS_SHARED_SURFACE_PUSH_H
 #define FIBSCOPE_SHADERS_SHARED_SURFACE_PUSH_H
@@ -53,7 +54,11 @@ struct SphereSurfacePush {
 // surface_merge.comp: per pixel, where the surface texel's depth is
 // strictly less than the G-buffer's (ties: the lines stay), the G-buffer
 // texel becomes {surface depth, surface fiber, kGBufferSurface | source,
-// surface tangent}.
+// surface tangent}; except a translucent slice (kSurfaceSourceSlice, its
+// colour's alpha below 255) over a drawn pixel, which leaves the texel as
+// it is: shade.comp blends the slice's colour over it by the alpha. (So a
+// translucent slice shows the fibers behind it, not other surfaces: the
+// surface target holds one surface per pixel.)
 struct SurfaceMergePush {
   uint64_t surface;  // SurfaceTexel per pixel
   uint64_t gbuffer;  // GBufferTexel per pixel (read and written)

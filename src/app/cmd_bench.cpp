@@ -14,9 +14,11 @@
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "app/anatomy_options.h"
 #include "app/commands.h"
 #include "app/render_options.h"
 #include "app/render_scene.h"
@@ -98,6 +100,7 @@ void runBench(const BenchOptions& o) {
   const FilterCriteria criteria = criteriaFrom(o.render.criteria).criteria;  // bad specs before any work
   uint32_t width = 0, height = 0;
   parseFrameSize(o.render.size, width, height);
+  const std::optional<NiftiVolume> volume = readAnatomyOption(o.render);  // a bad file before any work
   bool need_points = false;
   for (const Variant& v : variants) need_points |= v.settings.pipeline != RenderPipeline::Compute;
 
@@ -109,6 +112,12 @@ void runBench(const BenchOptions& o) {
   LoadedScene scene = loadScene(*context, scene_options);
   GpuScene gpu_scene = scene.gpuScene();
   for (Variant& v : variants) applyScalarColoring(*context, scene.fiblets, o.render, v.settings, gpu_scene);
+  GpuAnatomy anatomy;
+  if (volume) {
+    std::vector<RenderSettings*> fitted;
+    for (Variant& v : variants) fitted.push_back(&v.settings);
+    applyAnatomy(*context, *volume, o.render, fitted, anatomy, gpu_scene);
+  }
   // The criteria, evaluated once: each variant's frames read the kept bits
   // of its pipeline's input.
   const SceneFilter filter(*context, scene, criteria, o.render.dim_dropped);
@@ -142,7 +151,8 @@ void runBench(const BenchOptions& o) {
   for (uint32_t frame = 0; frame < total; ++frame) {
     // Warm-up frames run at the first frame's camera.
     const double azimuth = o.step_deg * double(frame < o.warmup ? 0 : frame - o.warmup);
-    const Camera camera = orbitCamera(scene.bounds, azimuth, o.elevation_deg, width, height, distance);
+    const Camera camera =
+        withAnatomyInView(orbitCamera(scene.bounds, azimuth, o.elevation_deg, width, height, distance), anatomy);
     for (size_t i = 0; i < variants.size(); ++i) {
       Variant& v = variants[i];
       const auto t0 = std::chrono::steady_clock::now();

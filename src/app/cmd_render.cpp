@@ -11,6 +11,7 @@
 #include <optional>
 #include <string>
 
+#include "app/anatomy_options.h"
 #include "app/commands.h"
 #include "app/render_options.h"
 #include "app/render_scene.h"
@@ -68,6 +69,7 @@ void runRender(const RenderCommandOptions& o) {
   const FilterCriteria criteria = criteriaFrom(o.render.criteria).criteria;  // bad specs before any work
   uint32_t width = 0, height = 0;
   parseFrameSize(o.render.size, width, height);
+  const std::optional<NiftiVolume> volume = readAnatomyOption(o.render);  // a bad file before any work
 
   // The instance, the device and the frame renderer's pipelines (lavapipe
   // compiles every shader with LLVM here) take ~0.15 s on one core: made on
@@ -104,7 +106,12 @@ void runRender(const RenderCommandOptions& o) {
     filter.distanceRange(settings.scalar_min, settings.scalar_max);  // colour by distance: its range
   const SceneCuts cuts(context, o.render);
   cuts.apply(gpu_scene);
-  const Camera camera = cameraFor(o, scene, width, height);
+  GpuAnatomy anatomy;
+  if (volume) {
+    RenderSettings* fitted[] = {&settings};
+    applyAnatomy(context, *volume, o.render, fitted, anatomy, gpu_scene);
+  }
+  const Camera camera = withAnatomyInView(cameraFor(o, scene, width, height), anatomy);
   auto t = Clock::now();
   FrameRenderer& renderer = *device->renderer;
   const FrameStats stats = renderer.render(camera, settings, gpu_scene);
@@ -137,6 +144,8 @@ void addRenderCommand(CLI::App& app) {
   // culling would draw everything in its first phase and then only add a
   // depth pyramid and a second cull. The frustum test and LoD still pay.
   o->render.defaults.culling = CullingMode::Frustum;
+  // So that nobody mistakes left for right (--no-orientation-labels).
+  o->render.defaults.orientation_labels = true;
   addRenderCliOptions(cmd, o->render);
   cmd->add_option("--view", o->view, "sagittal | coronal | axial");
   cmd->add_option("--camera", o->camera, "AZ,EL,DIST: orbit angles in degrees and distance factor (0: framed snugly, 1: the bounding sphere fits)");

@@ -16,6 +16,7 @@
 #include "app/render_options.h"
 #include "app/viewer/viewer_app.h"
 #include "core/error.h"
+#include "render/settings_table.h"
 
 namespace fibscope {
 namespace {
@@ -75,6 +76,9 @@ void runView(ViewCommandOptions o) {
   parseFrameSize(o.render.size, v.width, v.height);
   v.settings = renderSettingsFrom(o.render);
   v.keep_scalar_range = o.render.gave("scalar-range");
+  v.anatomy = o.render.anatomy;
+  for (const SettingInfo& info : renderSettingsTable())
+    if (o.render.gave(info.name)) v.given_settings.insert(std::string(info.name));
   if (!o.screenshot.empty() && (o.screenshot.size() < 5 || o.screenshot.substr(o.screenshot.size() - 4) != ".png"))
     throw Error("--screenshot: the output must be a .png file, got '" + o.screenshot + "'");
   v.screenshot = o.screenshot;
@@ -97,6 +101,7 @@ void runView(ViewCommandOptions o) {
 void addViewCommand(CLI::App& app) {
   auto o = std::make_shared<ViewCommandOptions>();
   o->render.size = "1280x800";
+  o->render.defaults.orientation_labels = true;  // --no-orientation-labels
   CLI::App* cmd = app.add_subcommand("view", "Open the interactive viewer on tractograms (none: the built-in phantom)");
   addRenderCliOptions(cmd, o->render);
   // The viewer opens several files: the positional takes them all.

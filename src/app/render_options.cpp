@@ -55,6 +55,9 @@ void addRenderCliOptions(CLI::App* cmd, RenderCliOptions& o) {
   cmd->add_option("--cut-mesh", o.cut_meshes,
                   "Hide what lies inside (SPEC:inside) or outside (SPEC:outside) a closed mesh, per pixel: SPEC is "
                   "an OBJ file or box:X0,Y0,Z0,X1,Y1,Z1, obox:... or sphere:X,Y,Z,R; repeatable, at most 4");
+  cmd->add_option("--anatomy", o.anatomy,
+                  "NIfTI volume (.nii, .nii.gz: T1, FA, ...) shown as its three voxel-plane slices (--slice-i/j/k, "
+                  "--anatomy-range, --anatomy-opacity)");
   cmd->add_flag("--dim-dropped", o.dim_dropped,
                 "Draw the fibers the criteria drop dimmed (the kept ones highlighted) instead of hiding them");
   cmd->add_option("--device", o.device, "Vulkan device whose name contains this");

@@ -44,6 +44,8 @@ struct RenderCliOptions {
   // the planes and slab of --roi-set's set; --slab is a setting.
   std::vector<std::string> clip_planes;
   std::vector<std::string> cut_meshes;  // --cut-mesh SPEC:inside|outside (app/scene_cuts.h)
+  // --anatomy: a NIfTI volume shown as slices (app/anatomy_options.h).
+  std::string anatomy;
   // Whether the command line gave the setting `name`.
   bool gave(std::string_view name) const;
 };

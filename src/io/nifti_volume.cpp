@@ -152,7 +152,7 @@ std::string describe(const NiftiHeader& h) {
 
 }  // namespace
 
-NiftiVolume loadNiftiVolume(const std::string& path, NiftiValues mode) {
+NiftiVolume loadNiftiVolume(const std::string& path, NiftiValues mode, const NiftiVoxelLimit& limit) {
   ZFile file(path);
   unsigned char header_bytes[540];
   // sizeof_hdr first: a NIfTI-1 header is followed by data from byte 352 on,
@@ -164,6 +164,9 @@ NiftiVolume loadNiftiVolume(const std::string& path, NiftiValues mode) {
     got += file.read(header_bytes + 4, (v2 ? 540 : 348) - 4);
   }
   const NiftiHeader h = parseNiftiHeader(path, header_bytes, got);
+  if (limit.max_voxels > 0 && h.voxelsPerVolume() > limit.max_voxels)
+    fail(path, std::to_string(h.dim[1]) + " x " + std::to_string(h.dim[2]) + " x " + std::to_string(h.dim[3]) +
+                   " voxels, more than the " + std::to_string(limit.max_voxels) + " of " + std::string(limit.what));
 
   NiftiVolume v;
   v.path = path;

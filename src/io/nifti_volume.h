@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace fibscope {
@@ -54,12 +55,21 @@ enum class NiftiValues {
                 // |value| >= 0.5), else 0
 };
 
+// A bound on the voxels of the volume a caller accepts (0: only the
+// header's own limits, nifti_header.h), and what it is for, for the message.
+struct NiftiVoxelLimit {
+  uint64_t max_voxels = 0;
+  std::string_view what;  // "an anatomical image (512 MiB as float)"
+};
+
 // Reads `path`. Memory: the values (4 bytes a voxel of one volume) and a
 // 1 MiB buffer, whatever the header claims. Safe on untrusted files: throws
 // Error "PATH: ..." (one line) for a missing or unreadable file, a file that
 // is not NIfTI, a header nifti_header.h refuses (datatype, dims, pixdim,
-// scaling, singular or non-finite affine), voxel data shorter than the
-// header says (plain or gzipped) and corrupt gzip data.
-NiftiVolume loadNiftiVolume(const std::string& path, NiftiValues values = NiftiValues::Scaled);
+// scaling, singular or non-finite affine), a volume of more voxels than
+// `limit` allows (told by the header, before any voxel is read), voxel data
+// shorter than the header says (plain or gzipped) and corrupt gzip data.
+NiftiVolume loadNiftiVolume(const std::string& path, NiftiValues values = NiftiValues::Scaled,
+                            const NiftiVoxelLimit& limit = {});
 
 }  // namespace fibscope

@@ -38,13 +38,28 @@ constexpr std::pair<std::string_view, Colormap> kColormaps[] = {{"viridis", Colo
                                                                 {"grayscale", Colormap::Grayscale},
                                                                 {"coolwarm", Colormap::CoolWarm}};
 
+constexpr std::pair<std::string_view, SliceSampling> kSamplings[] = {{"trilinear", SliceSampling::Trilinear},
+                                                                   {"nearest", SliceSampling::Nearest}};
+constexpr std::pair<std::string_view, SliceAxis> kSliceAxes[] = {
+    {"i", SliceAxis::I}, {"j", SliceAxis::J}, {"k", SliceAxis::K}};
+
 }  // namespace
+
+float slicePosition(const RenderSettings& s, int axis) {
+  return axis == 0 ? s.slice_i : (axis == 1 ? s.slice_j : s.slice_k);
+}
+
+void setSlicePosition(RenderSettings& s, int axis, float position) {
+  (axis == 0 ? s.slice_i : (axis == 1 ? s.slice_j : s.slice_k)) = position;
+}
 
 RenderPipeline parseRenderPipeline(std::string_view name) { return parseName("pipeline", name, kPipelines); }
 CullingMode parseCullingMode(std::string_view name) { return parseName("culling", name, kCulling); }
 ColorMode parseColorMode(std::string_view name) { return parseName("color", name, kColors); }
 Lighting parseLighting(std::string_view name) { return parseName("lighting", name, kLighting); }
 Colormap parseColormap(std::string_view name) { return parseName("colormap", name, kColormaps); }
+std::string_view sliceSamplingName(SliceSampling sampling) { return nameOf(sampling, kSamplings); }
+std::string_view sliceAxisName(SliceAxis axis) { return nameOf(axis, kSliceAxes); }
 std::string_view renderPipelineName(RenderPipeline pipeline) { return nameOf(pipeline, kPipelines); }
 std::string_view cullingModeName(CullingMode mode) { return nameOf(mode, kCulling); }
 std::string_view colorModeName(ColorMode mode) { return nameOf(mode, kColors); }

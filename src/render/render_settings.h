@@ -51,6 +51,14 @@ enum class Colormap : uint8_t {
   CoolWarm,   // Moreland's diverging blue -> grey -> red (2009)
 };
 
+// The voxel axes of an anatomical volume: its slices are the planes
+// i = const, j = const, k = const (shared/anatomy.h).
+enum class SliceAxis : uint8_t { I, J, K };
+
+// How a slice samples the volume (shared/anatomy.h): trilinear is what
+// mrview shows by default; nearest shows the voxels as they are.
+enum class SliceSampling : uint8_t { Trilinear, Nearest };
+
 enum class Lighting : uint8_t {
   None,
   IlluminatedLines,  // Zoeckler / Stalling / Hege: diffuse and specular from the tangent alone
@@ -109,7 +117,35 @@ struct RenderSettings {
   // facing the viewer, so the slab moves with the view.
   float slab_mm = 0.0f;
   std::optional<std::array<double, 4>> slab_plane;
+  // Anatomical slices (GpuScene::anatomy; shared/anatomy.h): the planes of
+  // the volume's voxel axes through slice_i, slice_j, slice_k, voxel
+  // coordinates (voxel centres at integers; render and the viewer put them
+  // at the volume's centre unless given), each drawn when shown. The
+  // display range maps anatomy_min to black and anatomy_max to white
+  // (render and the viewer set it to the volume's robust range unless
+  // given: render/anatomy_slices.h). Opacity 1 hides what is behind a slice;
+  // below 1 the fibers behind show through, the slice's grey blended over
+  // them by the opacity; 0 draws no slice.
+  float slice_i = 0.0f, slice_j = 0.0f, slice_k = 0.0f;
+  bool show_slice_i = true, show_slice_j = true, show_slice_k = true;
+  float anatomy_min = 0.0f, anatomy_max = 1.0f;
+  float anatomy_opacity = 1.0f;
+  SliceSampling anatomy_sampling = SliceSampling::Trilinear;
+  // The slice the viewer's keys move, and the one the slab follows: with
+  // slab_follows_slice and a volume, each frame's slab_plane is that
+  // slice's world plane (the frame renderer sets it).
+  SliceAxis active_slice = SliceAxis::K;
+  bool slab_follows_slice = false;
+  // L/R, A/P, S/I at the middle of the image's edges and an axis triad in
+  // the bottom-right corner (x red, y green, z blue), stamped over the final
+  // image (render/orientation_labels.h). Off here; `render` and `view`
+  // turn it on by default.
+  bool orientation_labels = false;
 };
+
+// The slice position by axis (0 = i, 1 = j, 2 = k).
+float slicePosition(const RenderSettings& settings, int axis);
+void setSlicePosition(RenderSettings& settings, int axis, float position);
 
 // Parsing and names for the command line ("compute", "two-phase", ...).
 // parse* throw Error listing the accepted names.
@@ -123,6 +159,8 @@ std::string_view cullingModeName(CullingMode mode);
 std::string_view colorModeName(ColorMode mode);
 std::string_view lightingName(Lighting lighting);
 std::string_view colormapName(Colormap colormap);
+std::string_view sliceSamplingName(SliceSampling sampling);
+std::string_view sliceAxisName(SliceAxis axis);
 
 // GPU time of one pass of a frame.
 struct PassTiming {

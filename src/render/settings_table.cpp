@@ -74,6 +74,10 @@ T&& with(T&& info, bool (*relevant)(const RenderSettings&)) {
   return std::forward<T>(info);
 }
 
+// Slice positions are voxel coordinates: NIfTI allows 2^24 voxels a side,
+// an anatomical volume far fewer; the viewer's sliders span the volume.
+constexpr double kMaxSliceCoordinate = 1e6;
+
 bool isCompute(const RenderSettings& s) { return s.pipeline == RenderPipeline::Compute; }
 bool isCulled(const RenderSettings& s) { return isCompute(s) && s.culling != CullingMode::None; }
 bool isSolid(const RenderSettings& s) { return s.color == ColorMode::Solid; }
@@ -159,8 +163,51 @@ std::vector<SettingInfo> makeTable() {
   t.push_back(flag("fxaa", "FXAA", "Fast approximate anti-aliasing of the image", &RenderSettings::fxaa));
   t.push_back(color("background", "background", "Background colour R,G,B in [0, 1]", &RenderSettings::background));
   t.push_back(number("slab", "slab",
-                     "Draw only a slab this thick around the focal plane (moving with the view), mm; 0: off",
+                     "Draw only a slab this thick around the focal plane (moving with the view), or around the "
+                     "active anatomical slice with --slab-follows-slice, mm; 0: off",
                      &RenderSettings::slab_mm, 0, 1000, "mm"));
+  t.push_back(flag("orientation-labels", "orientation labels",
+                   "L/R, A/P, S/I at the image's edges and an axis triad (x red, y green, z blue) in a corner",
+                   &RenderSettings::orientation_labels));
+  // Anatomical slices (--anatomy; the viewer's anatomy panel).
+  auto anatomy = [&](SettingInfo info) {
+    info.group = "anatomy";
+    t.push_back(info);
+  };
+  anatomy(number("slice-i", "slice i",
+                 "The slice along the volume's first voxel axis at this voxel coordinate (voxel centres at "
+                 "integers; unless given, the volume's centre)",
+                 &RenderSettings::slice_i, 0, kMaxSliceCoordinate));
+  anatomy(number("slice-j", "slice j", "The same along the second voxel axis", &RenderSettings::slice_j, 0,
+                 kMaxSliceCoordinate));
+  anatomy(number("slice-k", "slice k", "The same along the third voxel axis", &RenderSettings::slice_k, 0,
+                 kMaxSliceCoordinate));
+  anatomy(flag("show-slice-i", "show i", "Anatomical slice along the first voxel axis", &RenderSettings::show_slice_i));
+  anatomy(flag("show-slice-j", "show j", "Anatomical slice along the second voxel axis", &RenderSettings::show_slice_j));
+  anatomy(flag("show-slice-k", "show k", "Anatomical slice along the third voxel axis", &RenderSettings::show_slice_k));
+  anatomy(choice("active-slice", "active slice", "i | j | k: the slice the viewer's Page Up/Down move and the slab "
+                 "follows", 3, [](int v) { return sliceAxisName(SliceAxis(v)); },
+                 getChoice<SliceAxis, &RenderSettings::active_slice>,
+                 setChoice<SliceAxis, &RenderSettings::active_slice>));
+  SettingInfo window = entry("anatomy-range", "display range",
+                             "MIN,MAX of the volume's values shown black to white (unless given, its 2nd to 98th "
+                             "percentile)",
+                             SettingKind::Range);
+  window.number = &RenderSettings::anatomy_min;
+  window.number_max = &RenderSettings::anatomy_max;
+  window.min = -1e30;
+  window.max = 1e30;
+  anatomy(window);
+  anatomy(number("anatomy-opacity", "opacity",
+                 "Opacity of the slices: 1 hides the fibers behind them, below 1 they show through; 0: no slices",
+                 &RenderSettings::anatomy_opacity, 0, 1));
+  anatomy(choice("anatomy-sampling", "sampling", "trilinear (as mrview) | nearest (the voxels as they are)", 2,
+                 [](int v) { return sliceSamplingName(SliceSampling(v)); },
+                 getChoice<SliceSampling, &RenderSettings::anatomy_sampling>,
+                 setChoice<SliceSampling, &RenderSettings::anatomy_sampling>));
+  anatomy(flag("slab-follows-slice", "slab follows slice",
+               "The slab (--slab) lies around the active anatomical slice instead of the focal plane",
+               &RenderSettings::slab_follows_slice));
   return t;
 }
 

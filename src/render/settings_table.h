@@ -47,6 +47,10 @@ struct SettingInfo {
   // The panel shows the setting only when this holds (null: always), e.g.
   // the colormap only with ColorMode::Scalar.
   bool (*relevant)(const RenderSettings&) = nullptr;
+  // The viewer panel that shows it: empty for the render settings panel,
+  // "anatomy" for the anatomy panel (whose slice sliders span the loaded
+  // volume rather than the table's range).
+  std::string_view group;
 };
 
 // The table, in the panel's order.

@@ -91,7 +91,8 @@ TEST_F(GpuCliRender, everyPipelineFramesTheSamePictureOfAFile) {
   std::vector<std::array<uint32_t, 4>> boxes;
   for (const std::string pipeline : {"compute", "raw-compute"}) {
     const std::string png = dir_.file(pipeline + ".png");
-    const auto r = runGpuFibscope("render --validate --size 640x480 --view coronal --no-ssao --pipeline " + pipeline +
+    const auto r = runGpuFibscope("render --validate --size 640x480 --view coronal --no-ssao --no-orientation-labels "
+                                  "--pipeline " + pipeline +
                                   " " + tck + " -o " + png);
     ASSERT_EQ(r.exit_code, 0) << r.output;
     boxes.push_back(litBox(test::readOurPng(png)));
@@ -119,7 +120,8 @@ TEST_F(GpuCliRender, criteriaHideOrDimTheDroppedFibersAndKeepWhatTheFilterComman
   const std::string tck = dir_.file("in.tck");
   ASSERT_EQ(test::runFibscope("phantom " + tck + " -n 400 --seed 4").exit_code, 0);
   const std::string criteria = " --include box:-60,-60,30,60,60,60 --exclude sphere:0,0,10,12 --min-length 30";
-  const std::string common = "render --validate --size 320x240 --view coronal --no-ssao --background 0,0,0 ";
+  const std::string common =
+      "render --validate --size 320x240 --view coronal --no-ssao --no-orientation-labels --background 0,0,0 ";
   std::vector<std::vector<uint8_t>> lit;
   std::vector<uint64_t> kept;
   for (const std::string& extra : std::vector<std::string>{"", criteria, criteria + " --dim-dropped", criteria + " --pipeline raw-compute",

@@ -30,10 +30,11 @@ using test::readOurPng;
 
 const std::string kXvfb = "xvfb-run -a -s '-screen 0 640x480x24' env ";
 
-// The child is leak-checked under ASan: see gpu_cli_render_test.cpp.
+// The child is leak-checked under ASan: see gpu_cli_render_test.cpp. No
+// orientation labels: the tests read every drawn pixel as a fiber's.
 test::CommandResult runViewer(const std::string& args, const std::string& cache_dir, const std::string& prefix = "") {
-  return test::runCommand(prefix + "FIBSCOPE_CACHE_DIR='" + cache_dir + "' " + FIBSCOPE_EXE + " view --validate " +
-                          args);
+  return test::runCommand(prefix + "FIBSCOPE_CACHE_DIR='" + cache_dir + "' " + FIBSCOPE_EXE +
+                          " view --validate --no-orientation-labels " + args);
 }
 
 std::string lines(const std::vector<std::string>& script) {

@@ -526,7 +526,8 @@ TEST_F(GpuViewer, scriptedPicksSelectHighlightAndExportTheFiberUnderThePixel) {
   // The scene alone at the window's size and camera: which pixels are drawn.
   const std::string script1 = dir_.file("look.txt"), scene_png = dir_.file("scene.png");
   test::writeBytes(script1, "wait 2\nscreenshot " + scene_png + " 320x200\nquit\n");
-  auto r = runViewer("--offscreen --size 320x200 --script " + script1 + " " + fbl);
+  // No orientation labels: the image's drawn pixels must be the fibers'.
+  auto r = runViewer("--offscreen --size 320x200 --no-orientation-labels --script " + script1 + " " + fbl);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const Png scene = readOurPng(scene_png);
   ASSERT_EQ(scene.width, 320u);
@@ -580,7 +581,7 @@ TEST_F(GpuViewer, scriptedPicksSelectHighlightAndExportTheFiberUnderThePixel) {
                    "expect-selected 0\n"
                    "wait 1\n"
                    "quit\n");
-  r = runViewer("--offscreen --size 320x200 --script " + script2 + " " + fbl);
+  r = runViewer("--offscreen --size 320x200 --no-orientation-labels --script " + script2 + " " + fbl);
   ASSERT_EQ(r.exit_code, 0) << r.output;
 
   const Tractogram one = readAllStreamlines(*openTractogram(one_tck));

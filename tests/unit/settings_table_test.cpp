@@ -111,7 +111,8 @@ TEST(SettingsTable, theScriptAndTheValidationRejectWhatIsOutOfRangeWithTheRange)
 TEST(SettingsTable, theCommandLineTakesEveryEntryWithTheSameRange) {
   const auto help = test::runFibscope("render --help");
   ASSERT_EQ(help.exit_code, 0) << help.output;
-  const RenderSettings render_defaults;
+  RenderSettings render_defaults;
+  render_defaults.orientation_labels = true;  // render's own default (--no-orientation-labels)
   for (const SettingInfo& info : renderSettingsTable()) {
     SCOPED_TRACE(std::string(info.name));
     const bool negated = info.kind == SettingKind::Flag && render_defaults.*info.flag;

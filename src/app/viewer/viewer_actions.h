@@ -109,12 +109,22 @@ struct ResizeAction {  // the window (or the offscreen image) to this size in pi
   uint32_t width = 0, height = 0;
 };
 struct QuitAction {};
+// An anatomical image (.nii, .nii.gz) shown as slices, replacing the one
+// shown (viewer_anatomy.h); an empty path removes it.
+struct AnatomyAction {
+  std::string path;
+};
+// Moves the active slice (RenderSettings::active_slice) by this many
+// voxels, within the volume (Page Up / Page Down).
+struct SliceStepAction {
+  double voxels = 0;
+};
 
 using ViewerAction = std::variant<OrbitAction, PanAction, DollyAction, ViewAction, FovAction, SetAction,
                                   ScreenshotAction, OpenAction, CloseModelAction, ModelAction, PickAction, ClearSelectionAction,
                                   ExportSelectionAction, ExpectSelectedAction, DissectionAction, RoiSetFileAction,
                                   ExportKeptAction, ExpectKeptAction, RoiPlaceAction, RoiDragAction, RoiResizeAction,
-                                  ResizeAction, QuitAction>;
+                                  ResizeAction, QuitAction, AnatomyAction, SliceStepAction>;
 
 // Sets one RenderSettings field from text, as `set KEY VALUE` in a script:
 // KEY is a setting's name in render/settings_table.h (the command line's

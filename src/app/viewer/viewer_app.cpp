@@ -23,6 +23,7 @@
 #include "app/viewer/presentation.h"
 #include "app/viewer/recent_files.h"
 #include "app/viewer/viewer_cuts.h"
+#include "app/viewer/viewer_anatomy.h"
 #include "app/viewer/viewer_dissection.h"
 #include "app/viewer/viewer_input.h"
 #include "app/viewer/viewer_script.h"
@@ -185,6 +186,9 @@ class ViewerApp {
   void syncSelection() { syncSelection(currentScene()); }
   void pickAt(const PickAction& pick);
   GpuScene withSelection(const FrameScene& scene) const;
+  // An anatomy action (viewer_anatomy.h), between frames; `at_start`: the
+  // command line's (an error then ends the run).
+  void loadAnatomy(const std::string& path, bool at_start = false);
   std::string freshScreenshotPath();
 
   ViewerOptions options_;
@@ -214,6 +218,7 @@ class ViewerApp {
   std::unique_ptr<ViewerDissection> dissection_;
   std::unique_ptr<ViewerCuts> cuts_;  // the dissection's cut meshes on the GPU
   bool dissection_opened_ = false;  // the panel was opened for the dissection's first ROI or plane
+  ViewerAnatomy anatomy_;  // the anatomical image shown as slices
   // The scene the G-buffer shows (the last frame drawn; no models after a
   // resize or a frame without a model): picks map its fiber ids to the
   // model ids here.
@@ -329,6 +334,29 @@ void ViewerApp::createFrameObjects() {
   // line ends the run).
   if (options_.files.empty()) openModel("", true);
   for (const std::string& file : options_.files) openModel(file, true);
+  if (!options_.anatomy.empty()) loadAnatomy(options_.anatomy, true);
+}
+
+void ViewerApp::loadAnatomy(const std::string& path, bool at_start) {
+  finishFrame();  // the frame in flight may read the volume replaced
+  try {
+    if (path.empty()) {
+      anatomy_.unload(state_);
+      state_.status = "anatomy closed";
+      return;
+    }
+    // The command line's slice positions and range stay for its image.
+    const auto given = [&](std::string_view name) { return at_start && options_.given_settings.count(name) > 0; };
+    anatomy_.load(*context_, path, state_, given);
+    state_.anatomy_path = path;
+    state_.status = "anatomy " + path;
+    std::fprintf(stderr, "fibscope view: anatomy %s: %d x %d x %d voxels\n", path.c_str(), state_.anatomy.dims[0],
+                 state_.anatomy.dims[1], state_.anatomy.dims[2]);
+  } catch (const Error& e) {
+    if (at_start) throw;
+    state_.status = e.what();
+    std::fprintf(stderr, "fibscope view: %s\n", e.what());
+  }
 }
 
 ViewerApp::~ViewerApp() { release(); }
@@ -349,6 +377,7 @@ void ViewerApp::release() {
   scene_lengths_.reset();
   dissection_.reset();  // cancels an export
   cuts_.reset();
+  anatomy_.unload(state_);
   scenes_.clear();
   destroyPresentation(*context_, presentation_);
   if (swapchain_.swapchain != VK_NULL_HANDLE) gpu::destroySwapchain(*context_, swapchain_);
@@ -758,6 +787,10 @@ void ViewerApp::apply(const ViewerAction& action) {
           applyDissection(action);
         } else if constexpr (std::is_same_v<A, QuitAction>) {
           quit_ = true;
+        } else if constexpr (std::is_same_v<A, AnatomyAction>) {
+          loadAnatomy(a.path);
+        } else if constexpr (std::is_same_v<A, SliceStepAction>) {
+          stepActiveSlice(state_, a.voxels);
         }
       },
       action);
@@ -914,7 +947,7 @@ void ViewerApp::takeScreenshot(const ScreenshotAction& shot) {
     if (scene.empty()) throw Error("screenshot: no visible model to draw");
     if (!shot_renderer_) shot_renderer_ = std::make_unique<FrameRenderer>(*context_, shot.width, shot.height);
     shot_renderer_->resize(shot.width, shot.height);
-    const Camera camera = controller_.camera(shot.width, shot.height);
+    const Camera camera = anatomy_.inView(controller_.camera(shot.width, shot.height));
     syncSelection(scene);
     shot_renderer_->render(camera, scene.settings, withSelection(scene));
     writePngRgba(path, shot.width, shot.height, downloadColor(*context_, shot_renderer_->targets()));
@@ -993,6 +1026,7 @@ GpuScene ViewerApp::withSelection(const FrameScene& scene) const {
   // The bits were uploaded for this scene's numbering by syncSelection(scene).
   GpuScene gpu = scene.gpu;
   if (!scene.dissection_selects) gpu.selection_bits = selection_->bits();
+  gpu.anatomy = anatomy_.gpu();  // the slices with whatever models are drawn
   return gpu;
 }
 
@@ -1125,7 +1159,7 @@ bool ViewerApp::drawFrame(uint32_t width, uint32_t height, double dt) {
   if (visible_ids != scalar_range_ids_) fitScalarRange();
   ensureRawFor(state_.active_model);
   if (state_.fov_deg != controller_.fovY()) controller_.setFovY(state_.fov_deg);
-  const Camera camera = controller_.camera(width, height);
+  const Camera camera = anatomy_.inView(controller_.camera(width, height));
   const FrameScene scene = currentScene();
   syncSelection(scene);  // the highlight's bits for this frame (nothing in flight now)
 

@@ -7,6 +7,8 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -36,6 +38,11 @@ struct ViewerOptions {
   // settings.clip_planes join its planes.
   RoiSet dissection;
   bool dim_dropped = false;
+  // An anatomical image shown as slices from the start (--anatomy), with
+  // the settings the command line gave (kept for it: slice positions and
+  // display range), by their names in render/settings_table.h.
+  std::string anatomy;
+  std::set<std::string, std::less<>> given_settings;
   bool validate = false;   // validation layers on; any message fails the run
   std::string device;
   RenderSettings settings;

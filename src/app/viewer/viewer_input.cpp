@@ -6,6 +6,8 @@
 #include <cmath>
 #include <string>
 
+#include "app/viewer/viewer_anatomy.h"
+
 namespace fibscope {
 
 bool isObjPath(std::string_view path) {
@@ -112,6 +114,17 @@ std::vector<ViewerAction> InputMapper::map(const InputEvent& e, bool want_mouse,
         case GLFW_KEY_P:
           actions.push_back(ScreenshotAction{});  // empty path: the viewer picks a fresh name
           break;
+        // Anatomical slices (1/2/3 are the views): I/J/K choose the active
+        // slice, Page Up/Down move it a voxel (ten with shift).
+        case GLFW_KEY_I:
+        case GLFW_KEY_J:
+        case GLFW_KEY_K:
+          actions.push_back(SetAction{"active-slice", std::string(1, char('i' + (e.key - GLFW_KEY_I)))});
+          break;
+        case GLFW_KEY_PAGE_UP:
+        case GLFW_KEY_PAGE_DOWN:
+          actions.push_back(SliceStepAction{(e.key == GLFW_KEY_PAGE_UP ? 1.0 : -1.0) * (e.shift ? 10.0 : 1.0)});
+          break;
         default:
           break;
       }
@@ -119,10 +132,13 @@ std::vector<ViewerAction> InputMapper::map(const InputEvent& e, bool want_mouse,
     case InputEvent::Type::Drop:
       // A surface mesh becomes a cut keeping what lies inside it (the
       // fibers through a structure, the question a dropped mesh usually
-      // asks; one click flips it); anything else opens as a model.
+      // asks; one click flips it); images go to the anatomy; anything else
+      // opens as a model.
       for (const std::string& path : e.paths) {
         if (isObjPath(path))
           actions.push_back(DissectionAction{CutMeshAddEdit{MeshCut{path, /*cull_inside=*/false}}});
+        else if (isNiftiPath(path))
+          actions.push_back(AnatomyAction{path});
         else
           actions.push_back(OpenAction{path});
       }

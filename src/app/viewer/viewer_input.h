@@ -1,8 +1,10 @@
 // Mouse and keys to viewer actions, as mrview users expect: left drag
 // orbits, middle drag or shift + left drag pans, the wheel dollies; keys
 // 1/2/3 (or S/C/A) the sagittal, coronal and axial views, R resets,
-// F12 (or P) takes a screenshot; dropped files are opened, a dropped .obj
-// becomes a mesh cut that hides what lies outside it. A left click
+// F12 (or P) takes a screenshot; I/J/K choose the active anatomical slice,
+// Page Up/Down move it a voxel (shift: ten); dropped files are opened
+// (.nii/.nii.gz as the anatomical image, a .obj as a mesh cut that hides
+// what lies outside it). A left click
 // (press and release within kClickSlopPx) picks the fiber under it,
 // ctrl + click adds it to (or removes it from) the selection. The
 // dissection's ROIs: a right click places a sphere at the fiber under the

@@ -253,6 +253,10 @@ std::variant<ViewerAction, WaitFrames, WaitLoaded, WaitExported> parseCommand(co
       throw Error("resize: expected 16 to 16384 pixels each, got " + std::string(w[1]) + " x " + std::string(w[2]));
     return ViewerAction{ResizeAction{uint32_t(width), uint32_t(height)}};
   }
+  if (name == "anatomy") {
+    expectArguments(w, 1, 1, "anatomy FILE.nii[.gz]");
+    return ViewerAction{AnatomyAction{std::string(w[1])}};
+  }
   if (name == "quit") {
     expectArguments(w, 0, 0, "quit");
     return ViewerAction{QuitAction{}};
@@ -262,7 +266,7 @@ std::variant<ViewerAction, WaitFrames, WaitLoaded, WaitExported> parseCommand(co
               "pick, clear-selection, export-selection, expect-selected, roi-add, roi-place, roi-remove, "
               "roi-enable, ends-only, length, clip-plane-add, clip-plane-clear, cut-mesh-add, cut-mesh-clear, slab, "
               "dropped, roi-save, roi-load, "
-              "export-kept, expect-kept, resize or quit)");
+              "export-kept, expect-kept, resize, anatomy or quit)");
 }
 
 }  // namespace

@@ -72,6 +72,17 @@ struct SelectionInfo {
   std::string export_path = "selection.tck";
 };
 
+// The anatomical volume shown as slices (viewer_anatomy.h fills it), for
+// the anatomy panel (viewer_ui_anatomy.cpp) and the slice keys.
+struct AnatomyInfo {
+  std::string path;  // empty: none loaded
+  int dims[3] = {0, 0, 0};
+  double voxel_mm[3] = {0, 0, 0};
+  float min = 0, max = 0;                // of its finite values
+  float robust_min = 0, robust_max = 1;  // the default display range
+  bool loaded() const { return !path.empty(); }
+};
+
 struct ViewerState {
   RenderSettings settings;
   double fov_deg = 30;
@@ -99,6 +110,8 @@ struct ViewerState {
   // at the focal point and draws the ROIs' outlines with them.
   Camera camera;
   Bounds scene_bounds;
+  AnatomyInfo anatomy;
+  std::string anatomy_path;  // the anatomy panel's path entry
   // Every visible model is drawn; with a baseline pipeline (lines,
   // raw-compute: one tractogram) only the active one, which the status of
   // the settings panel then says.
@@ -124,6 +137,7 @@ struct ViewerState {
   // Opened by the frame loop when the dissection gets its first ROI or
   // plane (as the selection panel appears with a selection).
   bool show_dissection = false;
+  bool show_anatomy = true;
   std::string screenshot_path = "fibscope.png";  // the screenshot button's file
   std::string open_path;                         // the models panel's path entry
   int screenshot_width = 0, screenshot_height = 0;  // 0: the window as shown

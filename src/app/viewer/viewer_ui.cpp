@@ -10,16 +10,19 @@
 #include "render/settings_table.h"
 
 namespace fibscope {
-namespace {
 
-// The panel's widget of one setting of render/settings_table.h: its label,
-// its range (sliders clamp to it), its help as the tooltip.
-void settingWidget(RenderSettings& s, const SettingInfo& info) {
+void settingWidget(RenderSettings& s, const SettingInfo& table_info, double min, double max) {
+  SettingInfo info = table_info;
+  if (min < max) {
+    info.min = min;
+    info.max = max;
+  }
   const std::string label(info.label);
   const std::string unit = info.unit.empty() ? "" : " " + std::string(info.unit);
-  // Wide ranges (LoD in px, the scalar range) read better on a log scale.
+  // Wide ranges (LoD in px, the scalar range) read better on a log scale;
+  // a range given here (a volume's voxels) is linear.
   const ImGuiSliderFlags flags =
-      ImGuiSliderFlags_AlwaysClamp | (info.max - info.min > 200 ? ImGuiSliderFlags_Logarithmic : 0);
+      ImGuiSliderFlags_AlwaysClamp | (!(min < max) && info.max - info.min > 200 ? ImGuiSliderFlags_Logarithmic : 0);
   switch (info.kind) {
     case SettingKind::Flag: ImGui::Checkbox(label.c_str(), &(s.*info.flag)); break;
     case SettingKind::Integer:
@@ -55,6 +58,8 @@ void settingWidget(RenderSettings& s, const SettingInfo& info) {
   if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", std::string(info.help).c_str());
 }
 
+namespace {
+
 void settingsPanel(ViewerState& state, std::vector<ViewerAction>& actions) {
   ImGui::SetNextWindowPos(ImVec2(10, 200), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowSize(ImVec2(300, 0), ImGuiCond_FirstUseEver);
@@ -65,6 +70,7 @@ void settingsPanel(ViewerState& state, std::vector<ViewerAction>& actions) {
   RenderSettings& s = state.settings;
   for (const SettingInfo& info : renderSettingsTable()) {
     if (info.relevant && !info.relevant(s)) continue;
+    if (!info.group.empty()) continue;  // its own panel's
     if (info.name == "colormap") ImGui::TextDisabled("scalar: fiber length (mm)");
     settingWidget(s, info);
     if (info.name == "pipeline" && state.baseline_draws_active_only)
@@ -188,6 +194,7 @@ std::vector<ViewerAction> drawViewerUi(ViewerState& state) {
       ImGui::MenuItem("Performance", nullptr, &state.show_performance);
       ImGui::MenuItem("Selection", nullptr, &state.show_selection);
       ImGui::MenuItem("Dissection", nullptr, &state.show_dissection);
+      ImGui::MenuItem("Anatomy", nullptr, &state.show_anatomy);
       ImGui::EndMenu();
     }
     if (ImGui::MenuItem("Screenshot")) actions.push_back(ScreenshotAction{});
@@ -200,6 +207,7 @@ std::vector<ViewerAction> drawViewerUi(ViewerState& state) {
   if (state.show_selection) drawSelectionPanel(state, actions);
   drawDissectionOverlay(state);
   if (state.show_dissection) drawDissectionPanel(state, actions);
+  if (state.show_anatomy) drawAnatomyPanel(state, actions);
   statusLine(state);
   return actions;
 }

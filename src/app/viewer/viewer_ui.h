@@ -7,10 +7,18 @@
 
 #include <vector>
 
+#include <cmath>
+
 #include "app/viewer/viewer_actions.h"
 #include "app/viewer/viewer_state.h"
+#include "render/settings_table.h"
 
 namespace fibscope {
+
+// The panel's widget of one setting of render/settings_table.h: its label,
+// its range (sliders clamp to it; min < max replaces the table's, e.g. a
+// slice's by the loaded volume), its help as the tooltip.
+void settingWidget(RenderSettings& settings, const SettingInfo& info, double min = NAN, double max = NAN);
 
 std::vector<ViewerAction> drawViewerUi(ViewerState& state);
 
@@ -31,5 +39,9 @@ void drawSelectionPanel(ViewerState& state, std::vector<ViewerAction>& actions);
 // scene (drawn whether the panel is open or not).
 void drawDissectionPanel(ViewerState& state, std::vector<ViewerAction>& actions);
 void drawDissectionOverlay(const ViewerState& state);
+// viewer_ui_anatomy.cpp: the anatomy panel (the image's path entry, its
+// grid and values, the slices with sliders over its voxels, the display
+// range, opacity, sampling, the slab following the active slice).
+void drawAnatomyPanel(ViewerState& state, std::vector<ViewerAction>& actions);
 
 }  // namespace fibscope

@@ -4,6 +4,7 @@
 
 #include "core/error.h"
 #include "gpu/submit.h"
+#include "render/gpu/anatomy.h"
 #include "render/settings_table.h"
 
 namespace fibscope {
@@ -47,8 +48,11 @@ void FrameRenderer::prepare(const RenderSettings& settings) {
   for (auto& stage : stages_) stage->prepare(context_, settings);
 }
 
-void FrameRenderer::record(VkCommandBuffer cmd, const Camera& camera, const RenderSettings& settings,
+void FrameRenderer::record(VkCommandBuffer cmd, const Camera& camera, const RenderSettings& given,
                            const GpuScene& scene) {
+  // The slab around the active anatomical slice, when asked to follow it.
+  const RenderSettings settings =
+      scene.anatomy && !scene.anatomy->empty() ? withSlabFollowingSlice(given, scene.anatomy->grid()) : given;
   if (camera.width != targets_.width || camera.height != targets_.height)
     throw Error("render: camera is " + std::to_string(camera.width) + " x " + std::to_string(camera.height) +
                 " px, the frame " + std::to_string(targets_.width) + " x " + std::to_string(targets_.height));

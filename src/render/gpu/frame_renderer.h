@@ -43,8 +43,10 @@ class FrameRenderer {
   void prepare(const RenderSettings& settings);
 
   // Records one whole frame into `cmd` (the camera's size must be the
-  // renderer's). Throws Error for a missing scene input or settings out of
-  // their range (render/settings_table.h), before anything is recorded.
+  // renderer's). With slab_follows_slice and a scene anatomy, the slab lies
+  // around the active slice (withSlabFollowingSlice). Throws Error for a
+  // missing scene input or settings out of their range
+  // (render/settings_table.h), before anything is recorded.
   void record(VkCommandBuffer cmd, const Camera& camera, const RenderSettings& settings, const GpuScene& scene);
   // The statistics of the frame last recorded, once its submission has
   // completed.

@@ -15,9 +15,11 @@ FrameStageList standardFrameStages() {
       makeLinesStage,
       // Surfaces into the surface target, then merged by depth.
       makeSphereStage,
+      makeAnatomyStage,
       makeSurfaceMergeStage,
   };
   for (FrameStageFactory& f : shadingStages()) list.push_back(std::move(f));
+  list.push_back(makeOrientationStage);  // over the final image
   return list;
 }
 

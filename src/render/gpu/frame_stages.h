@@ -25,6 +25,8 @@ std::unique_ptr<FrameStage> makeRawComputeStage(const gpu::VulkanContext& contex
 std::unique_ptr<FrameStage> makeLinesStage(const gpu::VulkanContext& context);
 // Surfaces: "spheres", GpuScene::spheres ray-cast (sphere_surface.comp).
 std::unique_ptr<FrameStage> makeSphereStage(const gpu::VulkanContext& context);
+// Surfaces: "slices", GpuScene::anatomy's slices ray-cast (anatomy_slices.comp).
+std::unique_ptr<FrameStage> makeAnatomyStage(const gpu::VulkanContext& context);
 // "surface merge": the surface target into the G-buffer (surface_merge.comp).
 std::unique_ptr<FrameStage> makeSurfaceMergeStage(const gpu::VulkanContext& context);
 // Shading (shading_stages.h).
@@ -32,11 +34,15 @@ std::unique_ptr<FrameStage> makeTilesStage(const gpu::VulkanContext& context);
 std::unique_ptr<FrameStage> makeSsaoStage(const gpu::VulkanContext& context);
 std::unique_ptr<FrameStage> makeShadeStage(const gpu::VulkanContext& context);
 std::unique_ptr<FrameStage> makeFxaaStage(const gpu::VulkanContext& context);
+// "orientation": the orientation labels and axis triad over the final
+// image (orientation_overlay.comp), after FXAA.
+std::unique_ptr<FrameStage> makeOrientationStage(const gpu::VulkanContext& context);
 
 // tiles, ssao, shade, fxaa: the G-buffer (and surface target) -> RGBA8.
 FrameStageList shadingStages();
 // Everything a frame of any pipeline needs, in order: setup, the three
-// geometry stages, the surface stages, merge, shading.
+// geometry stages, the surface stages, merge, shading, the orientation
+// overlay.
 FrameStageList standardFrameStages();
 
 }  // namespace fibscope

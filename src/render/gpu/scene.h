@@ -12,6 +12,8 @@
 
 namespace fibscope {
 
+class GpuAnatomy;
+
 // The fiblets of one or more datasets (compute pipeline), drawn together
 // into one visibility buffer (the nearest fiber wins across datasets) with
 // scene-global fiblet and fiber ids (render/gpu/scene_table.h: dataset i's
@@ -54,6 +56,9 @@ struct GpuScene {
   // Analytic spheres (world mm) drawn as surfaces with the lines, at most
   // shader::kMaxSurfaceSpheres; their ids land in the G-buffer's fiber field.
   std::vector<shader::SurfaceSphere> spheres;
+  // An anatomical volume whose slices (RenderSettings::slice_*) are drawn
+  // as surfaces with the lines (render/gpu/anatomy.h); null: none.
+  const GpuAnatomy* anatomy = nullptr;
 };
 
 }  // namespace fibscope

@@ -18,6 +18,8 @@ namespace fibscope {
 namespace {
 
 constexpr uint32_t kColorModes = 5, kLightings = 2;
+// What the frame's surfaces ask of the shade pass.
+constexpr uint32_t kNoSurfaces = 0, kOpaqueSurfaces = 1, kTranslucentSlices = 2, kSurfaceKinds = 3;
 
 uint32_t shaderColorMode(ColorMode mode) {
   switch (mode) {
@@ -46,7 +48,7 @@ class ShadeStage final : public FrameStage {
   uint32_t maxPasses() const override { return 1; }
   bool runs(const FrameContext&) const override { return true; }
   void prepare(const gpu::VulkanContext& context, const RenderSettings& settings) override {
-    variant(context, shaderColorMode(settings.color), shaderLighting(settings.lighting), false);
+    variant(context, shaderColorMode(settings.color), shaderLighting(settings.lighting), kNoSurfaces);
   }
 
   void record(FrameContext& frame) override {
@@ -77,7 +79,11 @@ class ShadeStage final : public FrameStage {
     // Without scalars the scalar mode draws orientation (render_settings.h).
     uint32_t mode = shaderColorMode(s.color);
     if (mode == shader::kShadeColorScalar && frame.scene.fiber_scalars == 0) mode = shader::kShadeColorOrientation;
-    const gpu::ComputePipeline& pipeline = variant(frame.context, mode, shaderLighting(s.lighting), frame.surfaces);
+    // Translucent slices: the merge leaves the pixels behind them, shade
+    // blends the slice over them (shared/surface_push.h).
+    const bool translucent = frame.surfaces && frame.scene.anatomy && s.anatomy_opacity < 1.0f;
+    const uint32_t surfaces = !frame.surfaces ? kNoSurfaces : (translucent ? kTranslucentSlices : kOpaqueSurfaces);
+    const gpu::ComputePipeline& pipeline = variant(frame.context, mode, shaderLighting(s.lighting), surfaces);
 
     gpu::PassScope pass(frame.cmd, frame.timer, "shade", gpu::kComputeToCompute);
     shader::ShadePush push{};
@@ -95,13 +101,14 @@ class ShadeStage final : public FrameStage {
 
  private:
   const gpu::ComputePipeline& variant(const gpu::VulkanContext& context, uint32_t mode, uint32_t lighting,
-                                      bool surfaces) {
-    gpu::ComputePipeline& p = variants_[(mode * kLightings + lighting) * 2 + (surfaces ? 1 : 0)];
+                                      uint32_t surfaces) {
+    gpu::ComputePipeline& p = variants_[(mode * kLightings + lighting) * kSurfaceKinds + surfaces];
     if (p.pipeline == VK_NULL_HANDLE) {
-      std::array<uint32_t, 3> spec{};
+      std::array<uint32_t, 4> spec{};
       spec[shader::kShadeSpecColorMode] = mode;
       spec[shader::kShadeSpecLighting] = lighting;
-      spec[shader::kShadeSpecSurfaces] = surfaces ? 1u : 0u;
+      spec[shader::kShadeSpecSurfaces] = surfaces != kNoSurfaces ? 1u : 0u;
+      spec[shader::kShadeSpecTranslucentSlices] = surfaces == kTranslucentSlices ? 1u : 0u;
       p = gpu::createComputePipeline(context, "shade.comp", sizeof(shader::ShadePush),
                                      gpu::WorkgroupSize{shader::kPixelGroupSize, shader::kPixelGroupSize}, spec);
     }
@@ -110,7 +117,7 @@ class ShadeStage final : public FrameStage {
 
   gpu::Buffer block_;                                         // shader::ShadeBlock
   std::vector<uint32_t> colormaps_;                           // every colormap's table (colormap.h)
-  std::array<gpu::ComputePipeline, kColorModes * kLightings * 2> variants_{};  // (mode, lighting, surfaces)
+  std::array<gpu::ComputePipeline, kColorModes * kLightings * kSurfaceKinds> variants_{};  // (mode, lighting, surfaces)
 };
 
 }  // namespace

@@ -1,0 +1,49 @@
+// The viewer's anatomical image (DESIGN.md section 2): one NIfTI volume at a
+// time, shown as slices by every frame (GpuScene::anatomy), loaded from the
+// anatomy panel's path entry, a dropped .nii/.nii.gz, a script's `anatomy
+// FILE` or `view --anatomy FILE`; and the slice keys' rule. Loading reads
+// the file on the calling thread (a 1 mm T1 takes well under a second).
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "app/viewer/viewer_state.h"
+#include "gpu/vulkan_context.h"
+#include "render/camera.h"
+#include "render/gpu/anatomy.h"
+
+namespace fibscope {
+
+// .nii or .nii.gz (any case): an anatomical image rather than a tractogram.
+bool isNiftiPath(std::string_view path);
+
+// Moves the active slice of state.settings by `voxels`, clamped to the
+// loaded volume's [0, dim - 1]; nothing without a volume.
+void stepActiveSlice(ViewerState& state, double voxels);
+
+class ViewerAnatomy {
+ public:
+  // Reads and uploads `path` (the device must not be using the current
+  // volume: call between frames), replacing the volume shown; state.anatomy
+  // describes it and state.settings' slices go to its centre and the
+  // display range to its robust range, except the settings `given` names
+  // (null: none). Throws Error "PATH: ..." (one line) and keeps the current
+  // volume when the file cannot be shown.
+  void load(const gpu::VulkanContext& context, const std::string& path, ViewerState& state,
+            const std::function<bool(std::string_view)>& given = nullptr);
+  // No volume any more (same condition as load).
+  void unload(ViewerState& state);
+
+  // The volume for GpuScene::anatomy; null when none.
+  const GpuAnatomy* gpu() const { return volume_ && !volume_->empty() ? volume_.get() : nullptr; }
+  // The camera with its depth range widened to the whole volume.
+  Camera inView(const Camera& camera) const;
+
+ private:
+  std::unique_ptr<GpuAnatomy> volume_;
+};
+
+}  // namespace fibscope

@@ -1,0 +1,100 @@
+#include "render/anatomy_slices.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "core/error.h"
+
+namespace fibscope {
+
+NiftiVolume loadAnatomyVolume(const std::string& path) {
+  return loadNiftiVolume(path, NiftiValues::Scaled,
+                         NiftiVoxelLimit{kMaxAnatomyVoxels, "an anatomical image (512^3, 512 MiB as float)"});
+}
+
+AnatomyGrid anatomyGrid(const NiftiVolume& volume) {
+  return AnatomyGrid{volume.dims, volume.voxel_to_world, volume.world_to_voxel};
+}
+
+PlaneEq slicePlane(const AnatomyGrid& grid, int axis, double position) {
+  // Voxel coordinate `axis` of world p is row `axis` of world_to_voxel
+  // (glm is column-major: m[column][row]) times (p, 1).
+  const glm::dmat4& m = grid.world_to_voxel;
+  const glm::dvec3 row(m[0][axis], m[1][axis], m[2][axis]);
+  const double length = glm::length(row);
+  return {row.x / length, row.y / length, row.z / length, (m[3][axis] - position) / length};
+}
+
+RenderSettings withSlabFollowingSlice(const RenderSettings& settings, const AnatomyGrid& grid) {
+  if (!settings.slab_follows_slice) return settings;
+  RenderSettings s = settings;
+  const int axis = int(settings.active_slice);
+  s.slab_plane = slicePlane(grid, axis, slicePosition(settings, axis));
+  return s;
+}
+
+ValueRange robustValueRange(std::span<const float> values) {
+  constexpr size_t kMaxSamples = size_t(1) << 22;
+  const size_t stride = std::max<size_t>(1, (values.size() + kMaxSamples - 1) / kMaxSamples);
+  std::vector<float> finite;
+  finite.reserve(std::min(values.size(), kMaxSamples));
+  for (size_t i = 0; i < values.size(); i += stride)
+    if (std::isfinite(values[i])) finite.push_back(values[i]);
+  if (finite.empty()) return {};
+  auto percentile = [&](double p) {
+    const size_t rank = size_t(std::floor(p * double(finite.size() - 1) + 0.5));
+    std::nth_element(finite.begin(), finite.begin() + std::ptrdiff_t(rank), finite.end());
+    return finite[rank];
+  };
+  ValueRange r{percentile(0.02), percentile(0.98)};
+  if (r.min < r.max) return r;
+  const auto [lo, hi] = std::minmax_element(finite.begin(), finite.end());
+  if (*lo < *hi) return {*lo, *hi};
+  return {*lo - 1.0f, *lo};
+}
+
+float sliceCentre(const AnatomyGrid& grid, int axis) { return 0.5f * float(grid.dims[axis] - 1); }
+
+void fitAnatomySettings(RenderSettings& settings, const AnatomyGrid& grid, ValueRange robust,
+                        const std::function<bool(std::string_view)>& given) {
+  constexpr std::string_view kNames[3] = {"slice-i", "slice-j", "slice-k"};
+  for (int a = 0; a < 3; ++a)
+    if (!given(kNames[a])) setSlicePosition(settings, a, sliceCentre(grid, a));
+  if (!given("anatomy-range")) {
+    settings.anatomy_min = robust.min;
+    settings.anatomy_max = robust.max;
+  }
+}
+
+std::array<Vec3d, 8> volumeCorners(const AnatomyGrid& grid) {
+  std::array<Vec3d, 8> corners{};
+  for (int c = 0; c < 8; ++c) {
+    const glm::dvec4 v((c & 1) ? grid.dims.x - 0.5 : -0.5, (c & 2) ? grid.dims.y - 0.5 : -0.5,
+                       (c & 4) ? grid.dims.z - 0.5 : -0.5, 1.0);
+    const glm::dvec4 w = grid.voxel_to_world * v;
+    corners[size_t(c)] = {w.x, w.y, w.z};
+  }
+  return corners;
+}
+
+Camera enclosingDepthRange(Camera camera, std::span<const Vec3d> points) {
+  const glm::dvec3 eye(camera.eye[0], camera.eye[1], camera.eye[2]);
+  const glm::dvec3 forward =
+      glm::normalize(glm::dvec3(camera.target[0], camera.target[1], camera.target[2]) - eye);
+  double nearest = INFINITY, farthest = 0;
+  for (const Vec3d& p : points) {
+    const double d = glm::dot(glm::dvec3(p[0], p[1], p[2]) - eye, forward);
+    if (!(d > 0)) continue;  // behind the eye: no near plane shows it
+    nearest = std::min(nearest, d);
+    farthest = std::max(farthest, d);
+  }
+  if (!(farthest > 0)) return camera;
+  camera.far_mm = std::max(camera.far_mm, 1.01 * farthest);
+  // Not nearer than a thousandth of the far plane: the depth buffer's
+  // float precision near the far plane falls with far / near.
+  camera.near_mm = std::min(camera.near_mm, std::max(0.99 * nearest, 1e-3 * camera.far_mm));
+  return camera;
+}
+
+}  // namespace fibscope
