@@ -126,14 +126,13 @@ bool sphereIsSmall(CameraBlock cam, vec3 c, float r) {
   return 2.0 * r * pc.focal_px < pc.lod_pixels * nearest;
 }
 
-// Phase 2: true when every pixel the fiblet could cover already holds a
-// depth nearer than the sphere's nearest depth. The sphere is enclosed in
-// the cube aligned with the view axes; its eight corners bound the sphere's
-// screen rectangle (perspective maps the cube to the hull of the projected
-// corners) and its nearest depth (depth grows with view distance, which is
-// linear, so its minimum over the cube is at a corner). A cube reaching
-// past the near plane is never occluded.
-bool sphereOccluded(CameraBlock cam, vec3 c, float r) {
+// The sphere's screen bounds from the cube around it aligned with the view
+// axes: its eight corners bound the sphere's NDC rectangle (perspective
+// maps the cube to the hull of the projected corners) and its depths
+// (depth grows with view distance, which is linear, so its extremes over
+// the cube are at corners). False when the cube reaches past the near plane.
+bool sphereScreenBounds(CameraBlock cam, vec3 c, float r, out vec2 lo, out vec2 hi, out float nearest,
+                        out float farthest) {
   const vec4 centre = cameraTransformPoint(cam.view_projection, c);
   // View axes in world space (rows of the view rotation), then to clip.
   vec4 axes[3];
@@ -141,8 +140,10 @@ bool sphereOccluded(CameraBlock cam, vec3 c, float r) {
     const vec3 e = vec3(cam.view[0][i], cam.view[1][i], cam.view[2][i]);
     axes[i] = r * (cam.view_projection[0] * e.x + cam.view_projection[1] * e.y + cam.view_projection[2] * e.z);
   }
-  vec2 lo = vec2(1e30), hi = vec2(-1e30);
-  float nearest = 1e30;
+  lo = vec2(1e30);
+  hi = vec2(-1e30);
+  nearest = 1e30;
+  farthest = -1e30;
   for (int k = 0; k < 8; ++k) {
     const vec4 q = centre + ((k & 1) != 0 ? axes[0] : -axes[0]) + ((k & 2) != 0 ? axes[1] : -axes[1]) +
                    ((k & 4) != 0 ? axes[2] : -axes[2]);
@@ -151,7 +152,22 @@ bool sphereOccluded(CameraBlock cam, vec3 c, float r) {
     lo = min(lo, ndc.xy);
     hi = max(hi, ndc.xy);
     nearest = min(nearest, ndc.z);
+    farthest = max(farthest, ndc.z);
   }
+  return true;
+}
+
+// Phase 2: true when every pixel the fiblet could cover already holds a
+// depth nearer than the sphere's nearest depth. The sphere is enclosed in
+// the cube aligned with the view axes; its eight corners bound the sphere's
+// screen rectangle (perspective maps the cube to the hull of the projected
+// corners) and its nearest depth (depth grows with view distance, which is
+// linear, so its minimum over the cube is at a corner). A cube reaching
+// past the near plane is never occluded.
+bool sphereOccluded(CameraBlock cam, vec3 c, float r) {
+  vec2 lo, hi;
+  float nearest, farthest;
+  if (!sphereScreenBounds(cam, c, r, lo, hi, nearest, farthest)) return false;
   const vec2 size = cam.viewport.xy;
   const float margin = 0.5 * cam.viewport.z + kCullPixelSlack;
   // Pixels whose centre px + 0.5 lies within margin of [lo, hi] in window
@@ -171,11 +187,11 @@ bool sphereOccluded(CameraBlock cam, vec3 c, float r) {
   const uint level_width = pyramidLevelSize(width, level);
   const uint offset = pyramidLevelOffset(width, height, level);
   PyramidRef pyramid = PyramidRef(pc.pyramid);
-  float farthest = 0.0;
+  float occluder = 0.0;  // the farthest depth drawn over the rectangle
   for (uint y = p0.y >> level; y <= p1.y >> level; ++y)
     for (uint x = p0.x >> level; x <= p1.x >> level; ++x)
-      farthest = max(farthest, pyramid.depths[offset + y * level_width + x]);
-  return farthest < nearest - kCullDepthSlack;
+      occluder = max(occluder, pyramid.depths[offset + y * level_width + x]);
+  return occluder < nearest - kCullDepthSlack;
 }
 
 layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer CutTilesRef { CutTile tiles[]; };
@@ -190,24 +206,9 @@ layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer Cu
 bool sphereMeshCut(CameraBlock cam, vec3 c, float r) {
   const CutMeshFrame cuts = cam.mesh_cuts;
   if (cuts.mesh_count == 0u) return false;
-  const vec4 centre = cameraTransformPoint(cam.view_projection, c);
-  vec4 axes[3];
-  for (int i = 0; i < 3; ++i) {
-    const vec3 e = vec3(cam.view[0][i], cam.view[1][i], cam.view[2][i]);
-    axes[i] = r * (cam.view_projection[0] * e.x + cam.view_projection[1] * e.y + cam.view_projection[2] * e.z);
-  }
-  vec2 lo = vec2(1e30), hi = vec2(-1e30);
-  float nearest = 1e30, farthest = -1e30;
-  for (int k = 0; k < 8; ++k) {
-    const vec4 q = centre + ((k & 1) != 0 ? axes[0] : -axes[0]) + ((k & 2) != 0 ? axes[1] : -axes[1]) +
-                   ((k & 4) != 0 ? axes[2] : -axes[2]);
-    if (!(q.z > 0.0) || !(q.w > 0.0)) return false;
-    const vec3 ndc = q.xyz / q.w;
-    lo = min(lo, ndc.xy);
-    hi = max(hi, ndc.xy);
-    nearest = min(nearest, ndc.z);
-    farthest = max(farthest, ndc.z);
-  }
+  vec2 lo, hi;
+  float nearest, farthest;
+  if (!sphereScreenBounds(cam, c, r, lo, hi, nearest, farthest)) return false;
   const vec2 size = cam.viewport.xy;
   const float margin = 0.5 * cam.viewport.z + kCullPixelSlack;
   const vec2 first = clamp(floor((lo + 1.0) * 0.5 * size - margin), vec2(0.0), size - 1.0);

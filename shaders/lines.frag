@@ -9,6 +9,7 @@
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 
 #include "glsl/raw_tractogram.glsl"
+#include "glsl/cut_mesh.glsl"
 
 layout(push_constant, std430) uniform Push { LinesPush pc; };
 
@@ -19,17 +20,12 @@ layout(location = 2) flat in uint in_tangent;
 layout(location = 0) out uvec4 texel;
 
 void main() {
-  const CutMeshFrame cuts = CameraRef(pc.camera).camera.mesh_cuts;
-  if (cuts.mesh_count != 0u) {
-    const CameraBlock cam = CameraRef(pc.camera).camera;
-    const uint width = uint(cam.viewport.x), pixels = width * uint(cam.viewport.y);
-    const uint index = uint(gl_FragCoord.y) * width + uint(gl_FragCoord.x);
-    UintsRef words = UintsRef(cuts.depths);
-    for (uint m = 0u; m < cuts.mesh_count; ++m) {
-      const bool inside = cutInside(words.values[2u * m * pixels + index], words.values[(2u * m + 1u) * pixels + index],
-                                    gl_FragCoord.z);
-      if (inside == (((cuts.inside_bits >> m) & 1u) != 0u)) discard;
-    }
+  const CameraBlock cam = CameraRef(pc.camera).camera;
+  if (cam.mesh_cuts.mesh_count != 0u) {
+    const uint width = uint(cam.viewport.x);
+    if (!cutMeshesKeep(cam.mesh_cuts, width * uint(cam.viewport.y), uint(gl_FragCoord.y) * width + uint(gl_FragCoord.x),
+                       gl_FragCoord.z))
+      discard;
   }
   texel = uvec4(floatBitsToUint(gl_FragCoord.z), in_fiber, in_segment, in_tangent);
 }

@@ -13,6 +13,7 @@
 
 #include "shared/render_config.h"
 #include "glsl/render_buffers.glsl"
+#include "glsl/cut_mesh.glsl"
 
 const float kSpanMargin = 1.0 / 64.0;
 
@@ -35,16 +36,6 @@ bool pixelCovered(int px, int py, vec3 a, vec3 ab, float length2, float radius2)
 // Covers pixel (px, py) with the segment a -> b (window x, y and depth)
 // when its centre lies within `radius` of it (step 5), nearest key wins
 // (steps 6, 7).
-// The mesh cuts (shared/cut_mesh.h) keep a fragment at this pixel and depth.
-bool cutMeshesKeep(CutMeshFrame cuts, uint pixels, uint index, float depth) {
-  UintsRef words = UintsRef(cuts.depths);
-  for (uint m = 0u; m < cuts.mesh_count; ++m) {
-    const bool inside = cutInside(words.values[2u * m * pixels + index], words.values[(2u * m + 1u) * pixels + index], depth);
-    if (inside == (((cuts.inside_bits >> m) & 1u) != 0u)) return false;
-  }
-  return true;
-}
-
 void rasterPixel(VisibilityRef vis, uint width, int px, int py, vec3 a, vec3 ab, float length2, float radius2,
                  uint64_t payload, CutMeshFrame cuts, uint pixels) {
   const vec2 c = vec2(float(px) + 0.5, float(py) + 0.5);
