@@ -256,7 +256,7 @@ TEST(ViewerDissection, movedAndScaledRegionsKeepTheirKindAndCentre) {
 
 TEST(ViewerDissection, panelOrientedBoxIsTheBoxItsSpecNames) {
   const OrientedBoxRegion o = orientedBox({1, 2, 3}, {4, 5, 6}, {10, -20, 30});
-  const auto& p = std::get<OrientedBoxRegion>(parseRegion("obox:1,2,3,4,5,6,10,-20,30"));
+  const OrientedBoxRegion p = std::get<OrientedBoxRegion>(parseRegion("obox:1,2,3,4,5,6,10,-20,30"));
   for (int k = 0; k < 3; ++k) {
     EXPECT_DOUBLE_EQ(o.half[k], p.half[k]);
     for (int j = 0; j < 3; ++j) EXPECT_DOUBLE_EQ(o.axes[k][j], p.axes[k][j]);
