@@ -45,12 +45,25 @@ void runFilterCommand(const FilterOptions& o) {
   std::error_code ec;
   const auto bytes = std::filesystem::is_regular_file(o.input, ec) ? std::filesystem::file_size(o.input, ec) : 0;
   Progress progress("filtering", double(bytes), "bytes");
-  const FilterReport r = runFilter(*reader, *writer, filter, o.threads,
-                                   [&](uint64_t done) { progress.set(double(done)); });
+  const auto report_progress = [&](uint64_t done) { progress.set(double(done)); };
+  // A .tck is tested in place (no copy of what is dropped); a file that
+  // turns out damaged on the way is read again by the reader, into a new
+  // output, so its messages are the reader's.
+  std::vector<std::string> warnings = reader->warnings();
+  std::optional<FilterReport> in_place;
+  if (reader->header().format == "tck" && reader->header().per_point.empty()) {
+    in_place = runTckFilterInPlace(o.input, *writer, filter, warnings, o.threads, report_progress);
+    if (!in_place) {
+      writer.reset();  // its temporary file goes with it
+      writer = createTractogramWriter(o.output, reader->header(), wo);
+    }
+  }
+  const FilterReport r = in_place ? *in_place : runFilter(*reader, *writer, filter, o.threads, report_progress);
+  if (!in_place) warnings = reader->warnings();
   writer->finish();
   progress.finish();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  for (const auto& w : reader->warnings()) std::fprintf(stderr, "fibscope: warning: %s\n", w.c_str());
+  for (const auto& w : warnings) std::fprintf(stderr, "fibscope: warning: %s\n", w.c_str());
   for (const auto& w : writer->warnings()) std::fprintf(stderr, "fibscope: warning: %s\n", w.c_str());
   std::printf("wrote %s: %llu of %llu streamlines kept (%s), %llu points, %.2f s\n", o.output.c_str(),
               static_cast<unsigned long long>(r.kept), static_cast<unsigned long long>(r.streamlines),

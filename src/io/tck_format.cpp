@@ -335,6 +335,14 @@ size_t TrackDataStream::fill(size_t n) {
   return available();
 }
 
+std::optional<std::string> tckCountWarning(bool has_count_line, int64_t header_count, uint64_t streamlines) {
+  const std::string holds = " the file holds " + std::to_string(streamlines) + " streamlines";
+  if (!has_count_line) return "header has no count;" + holds;
+  if (header_count >= 0 && static_cast<uint64_t>(header_count) != streamlines)
+    return "header says count " + std::to_string(header_count) + " but" + holds;
+  return std::nullopt;
+}
+
 bool isTckWriterOwnedKey(std::string_view key) {
   return key == "datatype" || key == "file" || key == "count" || key == "total_count" || key == "END";
 }

@@ -132,8 +132,12 @@ class TrackDataStream {
   uint64_t end() const { return end_; }
   // Forgets the first `n` buffered bytes (n <= available()).
   void consume(size_t n) { head_ += n; }
-  // Buffers at least `n` bytes (n <= 64, a triplet at most), fewer only at
-  // the end of the data. Reads ahead as much as fits. Returns available().
+  // Buffers at least `n` bytes (n <= capacity()), fewer only at the end of
+  // the data. Reads ahead as much as fits. Returns available().
+  size_t capacity() const { return capacity_; }
+  // Forgets the buffered bytes and goes on reading at `position` (in
+  // [begin, end)), keeping the buffer: a scan of many ranges of one file.
+  void restart(uint64_t position) { head_ = tail_ = 0, next_ = position; }
   size_t fill(size_t n);
 
  private:
@@ -151,6 +155,11 @@ class TrackDataStream {
   uint64_t next_ = 0;  // file offset of buffer_[tail_]
   uint64_t end_ = 0;
 };
+
+// The warning a reader gives when the header's count line is missing or
+// differs from the `streamlines` the file holds (nullopt when it agrees);
+// `header_count` < 0 for a count line that is not a number.
+std::optional<std::string> tckCountWarning(bool has_count_line, int64_t header_count, uint64_t streamlines);
 
 // `text` with control bytes replaced and cut to `max_chars`, for quoting file
 // contents inside one-line messages.

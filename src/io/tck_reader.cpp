@@ -199,11 +199,7 @@ bool TckReader::readStreamline(Tractogram& chunk) {
 
 void TckReader::endOfData(bool truncated) {
   at_end_ = true;
-  const std::string holds = " the file holds " + std::to_string(streamlines_) + " streamlines";
-  if (!has_count_line_)
-    warn("header has no count;" + holds);
-  else if (header_count_ >= 0 && static_cast<uint64_t>(header_count_) != streamlines_)
-    warn("header says count " + std::to_string(header_count_) + " but" + holds);
+  if (const auto w = tckCountWarning(has_count_line_, header_count_, streamlines_)) warn(*w);
   for (const auto& tsf : tsf_) {
     switch (tsf->end()) {
       case TsfReader::End::kTerminated:

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "select/block_boxes.h"
 #include "select/packed_region.h"
 #include "select/voxel_mask.h"
 
@@ -95,7 +96,11 @@ float FiberFilter::zoneDistance(const float* xyz, size_t n) const {
 }
 
 FilterVerdict FiberFilter::evaluate(const float* xyz, size_t n) const {
-  return evaluate(xyz, n, lengthInFloat(xyz, n));
+  // Without limits only "no points" counts (NaN, dropped as tckedit drops
+  // an empty streamline), and summing a square root per point was a sixth
+  // of `fibscope filter`'s time.
+  const bool limited = min_length_ > -INFINITY || max_length_ < INFINITY;
+  return evaluate(xyz, n, limited ? lengthInFloat(xyz, n) : n == 0 ? NAN : 0.0f);
 }
 
 FilterVerdict FiberFilter::evaluate(const float* xyz, size_t n, float length) const {
@@ -109,87 +114,103 @@ FilterVerdict FiberFilter::evaluate(const float* xyz, size_t n, float length) co
 
 FilterVerdict FiberFilter::evaluateRegions(const float* xyz, size_t n) const {
   if (include_.empty() && include_ordered_.empty() && exclude_.empty()) return {};
-  // The vertices tested: all, or the two ends.
-  const size_t visits = criteria_.ends_only ? 2 : n;
-  auto vertex = [&](size_t i) { return criteria_.ends_only ? xyz + (i == 0 ? 0 : 3 * (n - 1)) : xyz + 3 * i; };
-  // The streamline's box: a region whose box it misses holds none of its
-  // vertices, so most regions are decided for most streamlines without a
-  // test per vertex (this is where the time went: a test per vertex and
-  // region).
-  float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-  if (criteria_.ends_only) {
-    for (size_t i = 0; i < 2; ++i)
-      for (int k = 0; k < 3; ++k) {
-        lo[k] = std::min(lo[k], vertex(i)[k]);
-        hi[k] = std::max(hi[k], vertex(i)[k]);
-      }
-  } else {
-    // Straight over the points, in the form the compiler vectorises
-    // (a < b ? a : b is minps; a NaN coordinate is in no region anyway).
-    float lx = INFINITY, ly = INFINITY, lz = INFINITY, hx = -INFINITY, hy = -INFINITY, hz = -INFINITY;
-    for (size_t i = 0; i < n; ++i) {
-      const float x = xyz[3 * i], y = xyz[3 * i + 1], z = xyz[3 * i + 2];
-      lx = x < lx ? x : lx;
-      ly = y < ly ? y : ly;
-      lz = z < lz ? z : lz;
-      hx = x > hx ? x : hx;
-      hy = y > hy ? y : hy;
-      hz = z > hz ? z : hz;
-    }
-    lo[0] = lx, lo[1] = ly, lo[2] = lz, hi[0] = hx, hi[1] = hy, hi[2] = hz;
-  }
-  auto near = [&](const Packed& r) {
-    const float* b = r.region.box;
-    return !(hi[0] < b[0] || lo[0] > b[3] || hi[1] < b[1] || lo[1] > b[4] || hi[2] < b[2] || lo[2] > b[5]);
+  if (criteria_.ends_only) return evaluateEnds(xyz, n);
+  // The streamline's box and its runs' boxes (select/block_boxes.h): a
+  // region whose box a run's misses holds none of the run's points, so most
+  // regions are decided for most streamlines without a test per point, and
+  // the streamlines that come near one are tested in the runs that do
+  // (this is where the time went: a test per point and region).
+  thread_local BlockBoxes runs;
+  computeBlockBoxes(xyz, n, runs);
+  const float whole[6] = {runs.lo[0], runs.lo[1], runs.lo[2], runs.hi[0], runs.hi[1], runs.hi[2]};
+  constexpr size_t B = BlockBoxes::kBlockPoints;
+  // The regions of `list` whose boxes meet `box`, among `among`.
+  auto meeting = [](const std::vector<Packed>& list, const float* box, uint64_t among) {
+    uint64_t m = 0;
+    for (size_t r = 0; r < list.size(); ++r)
+      if ((among >> r & 1u) && boxesMeet(box, list[r].region.box)) m |= uint64_t(1) << r;
+    return m;
   };
-  auto contains = [](const Packed& r, const float* p) {
-    const shader::FilterRegion& g = r.region;
-    const shader::vec3 q(p[0], p[1], p[2]);
-    switch (g.kind) {
-      case shader::kFilterSphere: return shader::filterSphereContains(g.v[0], g.v[1], g.v[2], g.v[3], q);
-      case shader::kFilterBox: return shader::filterBoxContains(g.v[0], g.v[1], g.v[2], g.v[3], g.v[4], g.v[5], q);
-      case shader::kFilterOrientedBox:
-        return shader::filterOrientedBoxContains({g.v[0], g.v[1], g.v[2]}, {g.v[3], g.v[4], g.v[5]},
-                                                 {g.v[6], g.v[7], g.v[8]}, {g.v[9], g.v[10], g.v[11]},
-                                                 {g.v[12], g.v[13], g.v[14]}, q);
-      default: return r.mask->contains(p);
-    }
-  };
-  // In the verdict's order: an exclude region entered (the first vertex
-  // in one, its first region), an include missed (the first), the ordered
+  const uint64_t all = ~uint64_t(0);
+  // In the verdict's order: an exclude region entered (the first point in
+  // one, its first region), an include missed (the first), the ordered
   // includes; as tckedit decides each, whatever order they are tested in.
-  uint64_t candidates = 0;
-  for (size_t r = 0; r < exclude_.size(); ++r)
-    if (near(exclude_[r])) candidates |= uint64_t(1) << r;
-  if (candidates != 0)
-    for (size_t i = 0; i < visits; ++i)
-      for (size_t r = 0; r < exclude_.size(); ++r)
-        if ((candidates >> r & 1u) && contains(exclude_[r], vertex(i))) return {FilterReason::Exclude, uint32_t(r)};
+  if (const uint64_t near = meeting(exclude_, whole, all))
+    for (size_t b = 0; b < runs.blocks(); ++b)
+      if (const uint64_t here = meeting(exclude_, runs.box(b), near))
+        for (size_t i = B * b; i < std::min(n, B * (b + 1)); ++i)
+          for (size_t r = 0; r < exclude_.size(); ++r)
+            if ((here >> r & 1u) && contains(exclude_[r], xyz + 3 * i)) return {FilterReason::Exclude, uint32_t(r)};
   for (size_t r = 0; r < include_.size(); ++r) {
     bool reached = false;
-    if (near(include_[r]))
-      for (size_t i = 0; i < visits && !reached; ++i) reached = contains(include_[r], vertex(i));
+    if (boxesMeet(whole, include_[r].region.box))
+      for (size_t b = 0; b < runs.blocks() && !reached; ++b)
+        if (boxesMeet(runs.box(b), include_[r].region.box))
+          for (size_t i = B * b; i < std::min(n, B * (b + 1)) && !reached; ++i)
+            reached = contains(include_[r], xyz + 3 * i);
     if (!reached) return {FilterReason::Include, uint32_t(r)};
   }
   if (include_ordered_.empty()) return {};
-  // The ordered includes: a vertex in ordered region k (the first that
+  // The ordered includes: a point in ordered region k (the first that
   // contains it) is fine when k is the next one to enter or the one entered
-  // last; anything else breaks the order.
-  candidates = 0;
-  for (size_t r = 0; r < include_ordered_.size(); ++r)
-    if (near(include_ordered_[r])) candidates |= uint64_t(1) << r;
+  // last; anything else breaks the order. A run near none of them holds no
+  // point in any, so it changes nothing.
+  const uint64_t near = meeting(include_ordered_, whole, all);
   size_t next = 0;
   bool in_order = true;
-  for (size_t i = 0; i < visits && in_order && candidates != 0; ++i)
-    for (size_t r = 0; r < include_ordered_.size(); ++r)
-      if ((candidates >> r & 1u) && contains(include_ordered_[r], vertex(i))) {
-        if (r == next) ++next;
-        else if (r + 1 != next) in_order = false;
-        break;
-      }
+  for (size_t b = 0; b < runs.blocks() && in_order && near != 0; ++b) {
+    const uint64_t here = meeting(include_ordered_, runs.box(b), near);
+    for (size_t i = B * b; i < std::min(n, B * (b + 1)) && in_order && here != 0; ++i)
+      orderedStep(here, xyz + 3 * i, next, in_order);
+  }
   if (!in_order || next != include_ordered_.size())
     return {FilterReason::IncludeOrdered, uint32_t(in_order ? next : 0)};
   return {};
+}
+
+FilterVerdict FiberFilter::evaluateEnds(const float* xyz, size_t n) const {
+  // tckedit -ends_only: the first and the last point (the same one for a
+  // streamline of one; none for an empty one).
+  const float* ends[2] = {xyz, n ? xyz + 3 * (n - 1) : xyz};
+  const size_t visits = n == 0 ? 0 : 2;
+  for (size_t i = 0; i < visits; ++i)
+    for (size_t r = 0; r < exclude_.size(); ++r)
+      if (contains(exclude_[r], ends[i])) return {FilterReason::Exclude, uint32_t(r)};
+  for (size_t r = 0; r < include_.size(); ++r) {
+    bool reached = false;
+    for (size_t i = 0; i < visits && !reached; ++i) reached = contains(include_[r], ends[i]);
+    if (!reached) return {FilterReason::Include, uint32_t(r)};
+  }
+  if (include_ordered_.empty()) return {};
+  size_t next = 0;
+  bool in_order = true;
+  for (size_t i = 0; i < visits && in_order; ++i) orderedStep(~uint64_t(0), ends[i], next, in_order);
+  if (!in_order || next != include_ordered_.size())
+    return {FilterReason::IncludeOrdered, uint32_t(in_order ? next : 0)};
+  return {};
+}
+
+void FiberFilter::orderedStep(uint64_t among, const float* p, size_t& next, bool& in_order) const {
+  for (size_t r = 0; r < include_ordered_.size(); ++r)
+    if ((among >> r & 1u) && contains(include_ordered_[r], p)) {
+      if (r == next) ++next;
+      else if (r + 1 != next) in_order = false;
+      return;
+    }
+}
+
+bool FiberFilter::contains(const Packed& r, const float* p) {
+  const shader::FilterRegion& g = r.region;
+  const shader::vec3 q(p[0], p[1], p[2]);
+  switch (g.kind) {
+    case shader::kFilterSphere: return shader::filterSphereContains(g.v[0], g.v[1], g.v[2], g.v[3], q);
+    case shader::kFilterBox: return shader::filterBoxContains(g.v[0], g.v[1], g.v[2], g.v[3], g.v[4], g.v[5], q);
+    case shader::kFilterOrientedBox:
+      return shader::filterOrientedBoxContains({g.v[0], g.v[1], g.v[2]}, {g.v[3], g.v[4], g.v[5]},
+                                               {g.v[6], g.v[7], g.v[8]}, {g.v[9], g.v[10], g.v[11]},
+                                               {g.v[12], g.v[13], g.v[14]}, q);
+    default: return r.mask->contains(p);
+  }
 }
 
 }  // namespace fibscope

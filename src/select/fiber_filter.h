@@ -100,6 +100,10 @@ class FiberFilter {
   float max_zone_d2_ = INFINITY;
   float zoneDistance2(const float* xyz, size_t n) const;
   FilterVerdict evaluateRegions(const float* xyz, size_t n) const;
+  FilterVerdict evaluateEnds(const float* xyz, size_t n) const;  // ends_only
+  // One point of the ordered-include walk, over the regions in `among`.
+  void orderedStep(uint64_t among, const float* p, size_t& next, bool& in_order) const;
+  static bool contains(const Packed& r, const float* p);
   float min_length_ = -INFINITY, max_length_ = INFINITY;  // with the margin
 };
 

@@ -16,6 +16,36 @@ constexpr size_t kChunkPoints = size_t(1) << 20;
 
 }  // namespace
 
+void FilterReport::count(const FilterVerdict& v, uint64_t n) {
+  ++streamlines;
+  points += n;
+  switch (v.reason) {
+    case FilterReason::Kept:
+      ++kept;
+      kept_points += n;
+      break;
+    case FilterReason::Length: ++by_length; break;
+    case FilterReason::Exclude: ++by_exclude[v.region]; break;
+    case FilterReason::Include: ++by_include[v.region]; break;
+    case FilterReason::IncludeOrdered: ++by_order; break;
+    case FilterReason::Distance: ++by_distance; break;
+  }
+}
+
+void FilterReport::add(const FilterReport& o) {
+  streamlines += o.streamlines;
+  points += o.points;
+  kept += o.kept;
+  kept_points += o.kept_points;
+  by_length += o.by_length;
+  by_order += o.by_order;
+  by_distance += o.by_distance;
+  by_exclude.resize(std::max(by_exclude.size(), o.by_exclude.size()), 0);
+  by_include.resize(std::max(by_include.size(), o.by_include.size()), 0);
+  for (size_t i = 0; i < o.by_exclude.size(); ++i) by_exclude[i] += o.by_exclude[i];
+  for (size_t i = 0; i < o.by_include.size(); ++i) by_include[i] += o.by_include[i];
+}
+
 void appendKeptStreamlines(const Tractogram& in, const std::vector<uint8_t>& keep, Tractogram& out) {
   for (size_t s = 0; s < in.streamlineCount(); ++s) {
     if (!keep[s]) continue;
@@ -81,29 +111,17 @@ FilterReport runFilter(TractogramReader& reader, TractogramWriter& writer, const
       for (size_t s = n * piece / pieces; s < n * (piece + 1) / pieces; ++s)
         verdicts[s] = filter.evaluate(chunk.point(chunk.offsets[s]), chunk.pointsIn(s));
     });
+    const uint64_t before = report.streamlines;  // input index of the chunk's first
     keep.assign(n, 0);
     for (size_t s = 0; s < n; ++s) {
-      const FilterVerdict& v = verdicts[s];
-      switch (v.reason) {
-        case FilterReason::Kept:
-          keep[s] = 1;
-          ++report.kept;
-          report.kept_points += chunk.pointsIn(s);
-          break;
-        case FilterReason::Length: ++report.by_length; break;
-        case FilterReason::Exclude: ++report.by_exclude[v.region]; break;
-        case FilterReason::Include: ++report.by_include[v.region]; break;
-        case FilterReason::IncludeOrdered: ++report.by_order; break;
-        case FilterReason::Distance: ++report.by_distance; break;
-      }
+      keep[s] = verdicts[s].kept();
+      report.count(verdicts[s], chunk.pointsIn(s));
     }
     if (grouped) {
-      kept_bits.resize((report.streamlines + n + 63) / 64, 0);
+      kept_bits.resize((before + n + 63) / 64, 0);
       for (size_t s = 0; s < n; ++s)
-        if (keep[s]) kept_bits[(report.streamlines + s) / 64] |= uint64_t(1) << ((report.streamlines + s) % 64);
+        if (keep[s]) kept_bits[(before + s) / 64] |= uint64_t(1) << ((before + s) % 64);
     }
-    report.streamlines += n;
-    report.points += chunk.pointCount();
     kept.clear();
     if (kept.per_streamline.size() != chunk.per_streamline.size() || kept.per_point.size() != chunk.per_point.size()) {
       kept.per_streamline.clear();

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,11 @@ struct FilterReport {
   // The input header's groups (TRX): written renumbered, and those left
   // without a kept member dropped.
   size_t groups_kept = 0, groups_dropped = 0;
+
+  // Counts one streamline of `points` points with its verdict.
+  void count(const FilterVerdict& v, uint64_t points);
+  // Adds the counts of a report on other streamlines of the same criteria.
+  void add(const FilterReport& other);
 };
 
 // Filters everything `reader` gives into `writer` (which the caller
@@ -37,6 +43,22 @@ struct FilterReport {
 // writer throw.
 FilterReport runFilter(TractogramReader& reader, TractogramWriter& writer, const FiberFilter& filter,
                        unsigned threads = 0, const std::function<void(uint64_t bytes)>& progress = {});
+
+// runFilter for a .tck on disk read in place (io/tck_scan.h): its ranges
+// tested on every core straight from the read buffers, and only the kept
+// streamlines copied, in their order, to `writer`. `warnings` gets what
+// the reader would say at the end of the data (the header's count). Returns
+// nullopt when the file cannot be scanned in place (not native float32, or
+// not well-formed: see tckScannableInPlace), having written nothing, or when
+// damage turns up on the way: then `writer` holds part of the output and is
+// to be thrown away, and the reader says what is wrong (runFilter).
+// `range_bytes`: the size of the ranges scanned (0: a few per thread, at
+// most 16 MiB; tests cut tiny ones to cross every kind of boundary).
+std::optional<FilterReport> runTckFilterInPlace(const std::string& path, TractogramWriter& writer,
+                                                const FiberFilter& filter, std::vector<std::string>& warnings,
+                                                unsigned threads = 0,
+                                                const std::function<void(uint64_t bytes)>& progress = {},
+                                                uint64_t range_bytes = 0);
 
 // The streamlines of `in` whose `keep` entry is non-zero, with their data,
 // appended to `out` (whose arrays must be named as `in`'s).
