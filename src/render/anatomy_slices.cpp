@@ -26,6 +26,31 @@ PlaneEq slicePlane(const AnatomyGrid& grid, int axis, double position) {
   return {row.x / length, row.y / length, row.z / length, (m[3][axis] - position) / length};
 }
 
+namespace {
+constexpr std::string_view kViews[3] = {"sagittal", "coronal", "axial"};  // normals along x, y, z
+}  // namespace
+
+std::string_view sliceAxisView(const AnatomyGrid& grid, int axis) {
+  const PlaneEq p = slicePlane(grid, axis, 0);
+  const double c[3] = {std::abs(p[0]), std::abs(p[1]), std::abs(p[2])};
+  return kViews[c[0] >= c[1] && c[0] >= c[2] ? 0 : c[1] >= c[2] ? 1 : 2];
+}
+
+int anatomicalSliceAxis(const AnatomyGrid& grid, std::string_view view) {
+  const auto it = std::find(std::begin(kViews), std::end(kViews), view);
+  if (it == std::end(kViews)) return -1;
+  const int world = int(it - std::begin(kViews));
+  // The axis whose normal has the largest share of that world axis.
+  int best = 0;
+  double most = -1;
+  for (int axis = 0; axis < 3; ++axis) {
+    const PlaneEq p = slicePlane(grid, axis, 0);
+    const double c = std::abs(p[size_t(world)]);
+    if (c > most) most = c, best = axis;
+  }
+  return best;
+}
+
 RenderSettings withSlabFollowingSlice(const RenderSettings& settings, const AnatomyGrid& grid) {
   if (!settings.slab_follows_slice) return settings;
   RenderSettings s = settings;

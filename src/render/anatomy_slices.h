@@ -44,6 +44,15 @@ AnatomyGrid anatomyGrid(const NiftiVolume& volume);
 // voxel coordinate, n.p + d = 0 on the plane.
 PlaneEq slicePlane(const AnatomyGrid& grid, int axis, double position);
 
+// The voxel axis (0 = i, 1 = j, 2 = k) whose slices are the `view`'s
+// ("sagittal", "coronal", "axial", as mrview and ROI sets name them): the
+// one whose slice normal lies nearest world x, y or z (i, j, k for an image
+// stored in RAS order; an oblique or permuted one picks its own). -1 for
+// another word.
+int anatomicalSliceAxis(const AnatomyGrid& grid, std::string_view view);
+// The view whose slices `axis` holds: its normal's largest world component.
+std::string_view sliceAxisView(const AnatomyGrid& grid, int axis);
+
 // `settings` with slab_plane at the active slice's plane when
 // slab_follows_slice is set (else unchanged).
 RenderSettings withSlabFollowingSlice(const RenderSettings& settings, const AnatomyGrid& grid);

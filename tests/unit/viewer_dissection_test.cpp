@@ -9,6 +9,7 @@
 #include <cmath>
 #include <glm/glm.hpp>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "app/viewer/dissection.h"
@@ -522,6 +523,56 @@ TEST(ViewerInput, shiftWheelAndBracketsResizeDeleteRemoves) {
   ASSERT_EQ(a.size(), 1u);
   EXPECT_TRUE(std::get<RoiRemoveEdit>(std::get<DissectionAction>(a[0]).edit).name.empty());  // the selected one
   EXPECT_TRUE(m.map(del, false, /*want_keyboard=*/true).empty());                            // typing in a panel
+}
+
+}  // namespace
+}  // namespace fibscope
+
+namespace fibscope {
+namespace {
+
+TEST(ViewerDissection, aSetsSlabFollowsTheActiveSliceOfItsViewByTheImagesAxes) {
+  // An image stored with voxel i along world S, j along R, k along A
+  // (a permuted, slightly oblique sform): its axial slices are i's.
+  AnatomyGrid permuted;
+  glm::dmat4 m(0.0);
+  m[0] = glm::dvec4(0.05, 0, 1, 0);  // column i: mostly +z
+  m[1] = glm::dvec4(1, 0, 0, 0);     // column j: +x
+  m[2] = glm::dvec4(0, 1, 0.05, 0);  // column k: mostly +y
+  m[3] = glm::dvec4(-90, -120, -70, 1);
+  permuted.voxel_to_world = m;
+  permuted.world_to_voxel = glm::inverse(m);
+  const AnatomyGrid ras;
+  for (const auto& [view, ras_axis, permuted_axis] :
+       {std::tuple{"sagittal", 0, 1}, std::tuple{"coronal", 1, 2}, std::tuple{"axial", 2, 0}}) {
+    SCOPED_TRACE(view);
+    EXPECT_EQ(anatomicalSliceAxis(ras, view), ras_axis);
+    EXPECT_EQ(anatomicalSliceAxis(permuted, view), permuted_axis);
+    EXPECT_EQ(sliceAxisView(permuted, permuted_axis), view);
+    RoiSet set;
+    set.slab = Slab{6.0f, view};
+    DissectionState d;
+    RenderSettings s;
+    loadRoiSetIntoState(set, d, s, &permuted);
+    EXPECT_TRUE(s.slab_follows_slice);
+    EXPECT_EQ(int(s.active_slice), permuted_axis);
+    EXPECT_FLOAT_EQ(s.slab_mm, 6.0f);
+    // Saved again, the word comes back (through either grid's own axis).
+    EXPECT_EQ(roiSetToSave(d, s, &permuted).slab->follow, view);
+    loadRoiSetIntoState(set, d, s);  // no image: RAS order
+    EXPECT_EQ(int(s.active_slice), ras_axis);
+    EXPECT_EQ(roiSetToSave(d, s).slab->follow, view);
+  }
+  // A slab that follows nothing stops following.
+  RoiSet plain;
+  plain.slab = Slab{4.0f, ""};
+  DissectionState d;
+  RenderSettings s;
+  s.slab_follows_slice = true;
+  loadRoiSetIntoState(plain, d, s);
+  EXPECT_FALSE(s.slab_follows_slice);
+  EXPECT_EQ(roiSetToSave(d, s).slab->follow, "");
+  EXPECT_EQ(anatomicalSliceAxis(ras, "oblique"), -1);
 }
 
 }  // namespace

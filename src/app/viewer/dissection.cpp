@@ -121,21 +121,29 @@ size_t addDissectionCuts(const RoiSet& set, RenderSettings& settings) {
   return left_out;
 }
 
-RoiSet roiSetToSave(const DissectionState& state, const RenderSettings& settings) {
+RoiSet roiSetToSave(const DissectionState& state, const RenderSettings& settings, const AnatomyGrid* grid) {
   RoiSet set = state.set;
+  const AnatomyGrid ras;
   if (settings.slab_mm > 0)
-    set.slab = Slab{settings.slab_mm, state.set.slab ? state.set.slab->follow : ""};
+    set.slab = Slab{settings.slab_mm, settings.slab_follows_slice
+                                          ? std::string(sliceAxisView(grid ? *grid : ras, int(settings.active_slice)))
+                                          : std::string()};
   else
     set.slab.reset();
   return set;
 }
 
-void loadRoiSetIntoState(RoiSet set, DissectionState& state, RenderSettings& settings) {
+void loadRoiSetIntoState(RoiSet set, DissectionState& state, RenderSettings& settings, const AnatomyGrid* grid) {
   if (enabledClipPlanes(set) > kMaxClipPlanes)
     throw Error("at most " + std::to_string(kMaxClipPlanes) + " clip planes may be enabled at once");
   if (enabledCutMeshes(set) > kMaxCutMeshes)
     throw Error("at most " + std::to_string(kMaxCutMeshes) + " cut meshes may be enabled at once");
   settings.slab_mm = set.slab ? set.slab->thickness_mm : 0.0f;
+  const std::string follow = set.slab ? set.slab->follow : "";
+  const AnatomyGrid ras;
+  const int axis = follow.empty() ? -1 : anatomicalSliceAxis(grid ? *grid : ras, follow);
+  settings.slab_follows_slice = axis >= 0;
+  if (axis >= 0) settings.active_slice = SliceAxis(axis);
   state.set = std::move(set);
   state.selected = -1;
 }

@@ -19,6 +19,7 @@
 
 #include <glm/vec3.hpp>
 
+#include "render/anatomy_slices.h"
 #include "render/camera.h"
 #include "render/render_settings.h"
 #include "select/roi_set.h"
@@ -126,12 +127,18 @@ size_t addDissectionCuts(const RoiSet& set, RenderSettings& settings);
 // --- ROI sets on disk -----------------------------------------------------
 
 // The set to save: the state's, with the slab of `settings` (thickness
-// slab_mm when > 0, the set's follow word).
-RoiSet roiSetToSave(const DissectionState& state, const RenderSettings& settings);
+// slab_mm when > 0; following the view of the active slice, "axial" ...,
+// when slab_follows_slice, by the axes of `grid`: the anatomy shown, null
+// for none, taken as RAS-ordered).
+RoiSet roiSetToSave(const DissectionState& state, const RenderSettings& settings,
+                    const AnatomyGrid* grid = nullptr);
 // Makes `set` the state (selection cleared) and its slab the settings'
-// slab_mm (0 without one). Throws Error (state unchanged) for more than
-// kMaxClipPlanes enabled planes or kMaxCutMeshes enabled cut meshes.
-void loadRoiSetIntoState(RoiSet set, DissectionState& state, RenderSettings& settings);
+// slab_mm (0 without one), a slab that follows a view the active slice of
+// that view (by `grid`'s axes, as above) with slab_follows_slice. Throws
+// Error (state unchanged) for more than kMaxClipPlanes enabled planes or
+// kMaxCutMeshes enabled cut meshes.
+void loadRoiSetIntoState(RoiSet set, DissectionState& state, RenderSettings& settings,
+                         const AnatomyGrid* grid = nullptr);
 // The world (n, d) planes of the command line (RenderSettings::clip_planes)
 // as the set's clip planes (point = -d n, the point of the plane nearest
 // the origin), for the viewer to own them.

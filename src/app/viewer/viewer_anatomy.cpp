@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <chrono>
 #include <cmath>
 
 #include "render/anatomy_slices.h"
@@ -28,7 +29,27 @@ void stepActiveSlice(ViewerState& state, double voxels) {
 
 void ViewerAnatomy::load(const gpu::VulkanContext& context, const std::string& path, ViewerState& state,
                          const std::function<bool(std::string_view)>& given) {
-  const NiftiVolume volume = loadAnatomyVolume(path);
+  show(context, path, loadAnatomyVolume(path), state, given);
+}
+
+void ViewerAnatomy::startLoad(const std::string& path) {
+  // A future from std::async joins in its destructor: an earlier load
+  // still reading is waited for here rather than left running.
+  pending_ = std::async(std::launch::async, [path] { return loadAnatomyVolume(path); });
+  pending_path_ = path;
+}
+
+bool ViewerAnatomy::poll(const gpu::VulkanContext& context, ViewerState& state) {
+  if (!pending_.valid() || pending_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return false;
+  const std::string path = pending_path_;
+  pending_path_.clear();
+  const NiftiVolume volume = pending_.get();  // throws the reader's Error
+  show(context, path, volume, state, nullptr);
+  return true;
+}
+
+void ViewerAnatomy::show(const gpu::VulkanContext& context, const std::string& path, const NiftiVolume& volume,
+                         ViewerState& state, const std::function<bool(std::string_view)>& given) {
   auto fresh = std::make_unique<GpuAnatomy>(GpuAnatomy::upload(context, volume));
   fitAnatomySettings(state.settings, fresh->grid(), fresh->robustRange(),
                      given ? given : [](std::string_view) { return false; });
@@ -47,6 +68,9 @@ void ViewerAnatomy::load(const gpu::VulkanContext& context, const std::string& p
 }
 
 void ViewerAnatomy::unload(ViewerState& state) {
+  if (pending_.valid()) pending_.wait();
+  pending_ = {};
+  pending_path_.clear();
   volume_.reset();
   state.anatomy = AnatomyInfo{};
 }

@@ -148,6 +148,9 @@ class ViewerApp {
   // Finished loads -> uploaded models (main thread, no frame in flight),
   // errors -> status and the panel; the running job's progress -> state_.
   void pollLoads();
+  // Shows the anatomical image read on its thread once it is (ViewerAnatomy::poll).
+  void pollAnatomy();
+  void anatomyShown(const std::string& path);
   void addModel(LoadEvent& event);
   void closeModel(int model);
   // The camera on the union of the visible models (every model when none
@@ -345,13 +348,17 @@ void ViewerApp::loadAnatomy(const std::string& path, bool at_start) {
       state_.status = "anatomy closed";
       return;
     }
-    // The command line's slice positions and range stay for its image.
-    const auto given = [&](std::string_view name) { return at_start && options_.given_settings.count(name) > 0; };
+    if (!at_start) {
+      // Read on a thread of its own while frames go on; pollAnatomy shows it.
+      anatomy_.startLoad(path);
+      state_.status = "reading anatomy " + path + " ...";
+      return;
+    }
+    // The command line's: read before the first frame, an error ends the
+    // run; its slice positions and range stay for its image.
+    const auto given = [&](std::string_view name) { return options_.given_settings.count(name) > 0; };
     anatomy_.load(*context_, path, state_, given);
-    state_.anatomy_path = path;
-    state_.status = "anatomy " + path;
-    std::fprintf(stderr, "fibscope view: anatomy %s: %d x %d x %d voxels\n", path.c_str(), state_.anatomy.dims[0],
-                 state_.anatomy.dims[1], state_.anatomy.dims[2]);
+    anatomyShown(path);
   } catch (const Error& e) {
     if (at_start) throw;
     state_.status = e.what();
@@ -392,6 +399,24 @@ void ViewerApp::openModel(const std::string& path, bool at_start) {
   const uint64_t id = loader_->request(path);
   if (at_start) startup_jobs_.push_back(id);
   job_first_frame_.emplace_back(id, frames_drawn_);
+}
+
+void ViewerApp::anatomyShown(const std::string& path) {
+  state_.anatomy_path = path;
+  state_.status = "anatomy " + path;
+  std::fprintf(stderr, "fibscope view: anatomy %s: %d x %d x %d voxels\n", path.c_str(), state_.anatomy.dims[0],
+               state_.anatomy.dims[1], state_.anatomy.dims[2]);
+}
+
+void ViewerApp::pollAnatomy() {
+  const std::string path = anatomy_.loadingPath();
+  try {
+    if (anatomy_.poll(*context_, state_)) anatomyShown(path);
+  } catch (const Error& e) {
+    // The volume shown stays.
+    state_.status = e.what();
+    std::fprintf(stderr, "fibscope view: %s\n", e.what());
+  }
 }
 
 void ViewerApp::pollLoads() {
@@ -822,13 +847,21 @@ void ViewerApp::applyDissection(const ViewerAction& action) {
             applyDissectionEdit(d, state_.settings, a.edit);
           } else if constexpr (std::is_same_v<A, RoiSetFileAction>) {
             if (a.save) {
-              saveRoiSet(roiSetToSave(d, state_.settings), a.path);
+              const AnatomyGrid* grid = anatomy_.gpu() ? &anatomy_.gpu()->grid() : nullptr;
+              RoiSet set = roiSetToSave(d, state_.settings, grid);
+              set.anatomy = state_.anatomy.loaded() ? state_.anatomy.path : "";
+              saveRoiSet(set, a.path);
               d.file_message = "saved " + a.path;
             } else {
               // Read whole before anything changes: a bad file leaves the state.
               RoiSet set = loadRoiSet(a.path);
-              loadRoiSetIntoState(std::move(set), d, state_.settings);
+              const std::string anatomy = set.anatomy;
+              const AnatomyGrid* grid = anatomy_.gpu() ? &anatomy_.gpu()->grid() : nullptr;
+              loadRoiSetIntoState(std::move(set), d, state_.settings, grid);
               d.file_message = "loaded " + a.path;
+              // The set's anatomy is shown (read while frames go on); a set
+              // without one leaves the image shown as it is.
+              if (!anatomy.empty() && anatomy != state_.anatomy.path) loadAnatomy(anatomy);
             }
             state_.status = d.file_message;
           } else if constexpr (std::is_same_v<A, ExportKeptAction>) {
@@ -1232,6 +1265,7 @@ void ViewerApp::run() {
     }
     finishFrame();
     pollLoads();  // after the fence: uploads run on this thread, nothing in flight
+    pollAnatomy();
     pollRawDecode();
     pollExport();
     // Frames and the script count once the models named at start are in.
@@ -1249,7 +1283,7 @@ void ViewerApp::run() {
         for (const ViewerAction& action : input_.map(event, imgui_->wantsMouse(), imgui_->wantsKeyboard()))
           apply(action);
     if (!starting)
-      for (const ViewerAction& action : script_.nextFrame(loader_->busy(), dissection_->exporting())) apply(action);
+      for (const ViewerAction& action : script_.nextFrame(loader_->busy() || anatomy_.loading(), dissection_->exporting())) apply(action);
     if (!starting && options_.orbit_deg_per_frame != 0)
       controller_.rotate(options_.orbit_deg_per_frame / OrbitController::kDegreesPerPixel, 0);
     // A quit still draws this frame: a screenshot asked for with it is taken.
@@ -1266,7 +1300,7 @@ void ViewerApp::run() {
     }
     // Offscreen nothing paces the frames: while a load runs, leave the
     // cores to the worker (a window is paced by vsync).
-    if (!window_ && loader_->busy()) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    if (!window_ && (loader_->busy() || anatomy_.loading())) std::this_thread::sleep_for(std::chrono::milliseconds(10));
     const bool frames_done_enough = options_.frames > 0 && frames_done >= options_.frames;
     const bool script_done = !script_.empty() && script_.finished() && !starting;
     if (!window_ || options_.frames > 0 || !script_.empty()) {

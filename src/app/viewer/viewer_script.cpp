@@ -342,7 +342,15 @@ std::vector<ViewerAction> ScriptRunner::nextFrame(bool loading, bool exporting) 
       waiting_exported_ = true;
       break;
     }
-    actions.push_back(std::get<ViewerAction>(step.command));
+    const ViewerAction& action = std::get<ViewerAction>(step.command);
+    actions.push_back(action);
+    if (std::holds_alternative<AnatomyAction>(action)) {
+      // The image is read while frames go on: the steps after it (a
+      // screenshot, a slice setting) see it shown, as after `open` and
+      // `wait-loaded`.
+      waiting_loaded_ = true;
+      break;
+    }
   }
   return actions;
 }

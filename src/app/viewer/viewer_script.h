@@ -16,7 +16,8 @@
 //   export-selection OUT.tck    (the selected fibers of one model: ViewerSelection::exportTck)
 //   expect-selected N           (the run fails naming the line unless N are selected)
 //   resize W H                 (the window, or the offscreen image, in pixels)
-//   anatomy FILE.nii[.gz]       (the anatomical image shown as slices; viewer_anatomy.h)
+//   anatomy FILE.nii[.gz]       (the anatomical image shown as slices, read while frames go on; the
+//                               script goes on once it is shown or refused; viewer_anatomy.h)
 // the virtual dissection (dissection.h, viewer_dissection.h):
 //   roi-add NAME include|exclude|include_ordered SPEC   (select/region.h's SPEC; a new NAME)
 //   roi-place X Y              (a sphere on the fiber drawn at that window pixel: the right click)

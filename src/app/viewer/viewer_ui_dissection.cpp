@@ -252,11 +252,9 @@ void cutsSection(ViewerState& state, std::vector<ViewerAction>& actions) {
   ImGui::SliderFloat("slab", &s.slab_mm, 0.0f, 200.0f, s.slab_mm > 0 ? "%.1f mm" : "off", ImGuiSliderFlags_AlwaysClamp);
   if (ImGui::IsItemHovered())
     ImGui::SetTooltip("draw only this thick a slab around the focal plane (moves with the view)");
-  if (set.slab && !set.slab->follow.empty())
-    ImGui::TextColored(kWarning, "the set's slab follows the %s slice: drawn about the focal plane for now",
-                       set.slab->follow.c_str());
+  if (s.slab_mm > 0 && s.slab_follows_slice)
+    ImGui::TextDisabled("the slab follows the active slice (%s)", std::string(sliceAxisName(s.active_slice)).c_str());
   cutMeshes(state, actions);
-  if (!set.anatomy.empty()) ImGui::TextDisabled("the set's anatomy is kept in the set, not drawn here yet");
 }
 
 void filesSection(ViewerState& state, std::vector<ViewerAction>& actions) {
