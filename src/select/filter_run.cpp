@@ -58,6 +58,9 @@ FilterReport runFilter(TractogramReader& reader, TractogramWriter& writer, const
   FilterReport report;
   report.by_exclude.assign(c.exclude.size(), 0);
   report.by_include.assign(c.include.size(), 0);
+  report.by_scalar.assign(c.scalar_ranges.size(), 0);
+  const std::string& path = reader.header().path;
+  resolveScalarColumns(c.scalar_ranges, reader.header().per_streamline, path);
   if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
 
   Tractogram chunks[2], kept;
@@ -77,9 +80,18 @@ FilterReport runFilter(TractogramReader& reader, TractogramWriter& writer, const
     const size_t n = chunk.streamlineCount();
     verdicts.assign(n, FilterVerdict{});
     const unsigned pieces = unsigned(std::min<size_t>(threads, std::max<size_t>(1, chunk.pointCount() / 65536)));
+    // The chunk's own arrays (their order is the reader's to choose).
+    const std::vector<ScalarColumn> columns = resolveScalarColumns(c.scalar_ranges, chunk.per_streamline, path);
     runPieces(pieces, [&](unsigned piece) {
-      for (size_t s = n * piece / pieces; s < n * (piece + 1) / pieces; ++s)
-        verdicts[s] = filter.evaluate(chunk.point(chunk.offsets[s]), chunk.pointsIn(s));
+      float scalars[FiberFilter::kMaxScalarRanges];
+      for (size_t s = n * piece / pieces; s < n * (piece + 1) / pieces; ++s) {
+        for (size_t r = 0; r < columns.size(); ++r) {
+          const DataArray& a = chunk.per_streamline[columns[r].array];
+          scalars[r] = a.values[s * a.components + columns[r].component];
+        }
+        verdicts[s] = filter.evaluate(chunk.point(chunk.offsets[s]), chunk.pointsIn(s),
+                                      std::span<const float>(scalars, columns.size()));
+      }
     });
     keep.assign(n, 0);
     for (size_t s = 0; s < n; ++s) {
@@ -91,6 +103,7 @@ FilterReport runFilter(TractogramReader& reader, TractogramWriter& writer, const
           report.kept_points += chunk.pointsIn(s);
           break;
         case FilterReason::Length: ++report.by_length; break;
+        case FilterReason::Scalar: ++report.by_scalar[v.region]; break;
         case FilterReason::Exclude: ++report.by_exclude[v.region]; break;
         case FilterReason::Include: ++report.by_include[v.region]; break;
         case FilterReason::IncludeOrdered: ++report.by_order; break;
