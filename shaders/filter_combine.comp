@@ -32,7 +32,7 @@ void main() {
   kept = kept && (pc.ordered_regions == 0u || h.z == kFilterOrderKept);
   if (pc.scalar_ranges != 0ul) {
     ScalarRangesRef ranges = ScalarRangesRef(pc.scalar_ranges);
-    const uint count = ranges.block.count;
+    const uint count = min(ranges.block.count, kFilterMaxScalarRanges);
     for (uint r = 0u; r < count; ++r) {
       const FilterScalarRange range = ranges.block.ranges[r];
       const float value = FloatsRef(range.values).values[pc.fiber_base + fiber];
