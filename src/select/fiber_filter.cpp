@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cassert>
+#include <limits>
 #include <string>
 
 #include "core/error.h"
@@ -28,6 +29,11 @@ float lengthInFloat(const float* xyz, size_t n) {
 // max), so that a float value compares with it as with the double.
 float keptSideFloat(double bound, bool is_min) {
   if (std::isnan(bound)) return is_min ? -INFINITY : INFINITY;
+  // Beyond a float's range (converting would be undefined): the float
+  // infinity on the bound's side, or the largest float on the kept side.
+  constexpr double kMax = std::numeric_limits<float>::max();
+  if (bound > kMax) return is_min ? INFINITY : float(kMax);
+  if (bound < -kMax) return is_min ? -float(kMax) : -INFINITY;
   float f = float(bound);
   if (is_min && double(f) < bound) f = std::nextafter(f, INFINITY);
   if (!is_min && double(f) > bound) f = std::nextafter(f, -INFINITY);

@@ -80,6 +80,19 @@ TEST(ScalarRange, floatBoundsDecideAsTheDoubleBounds) {
   }
 }
 
+TEST(ScalarRange, boundsBeyondAFloatsRangeDecideAsTheDoubles) {
+  const float big = std::numeric_limits<float>::max();
+  for (const auto& [lo, hi] : {std::pair{-1e300, 1e300}, std::pair{1e300, 2e300}, std::pair{-2e300, -1e300}}) {
+    FilterCriteria c;
+    c.scalar_ranges = {ScalarRange{"v", 0, lo, hi}};
+    const FiberFilter filter(c);
+    for (float v : {-INFINITY, -big, 0.0f, big, INFINITY}) {
+      const bool want = lo <= double(v) && double(v) <= hi;
+      EXPECT_EQ(filter.scalarOutside(std::span(&v, 1)) < 0, want) << lo << " " << hi << " " << v;
+    }
+  }
+}
+
 TEST(ScalarRange, nanValuesAreDroppedAndOpenEndsKeepInfinities) {
   FilterCriteria c;
   c.scalar_ranges = {ScalarRange{"a", 0, NAN, NAN}, ScalarRange{"b", 0, 1.0, NAN}};
