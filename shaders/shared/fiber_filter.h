@@ -10,8 +10,9 @@
 //            OR-ed into the fiber's FilterHits (atomicOr);
 //   ordered  per fiber, serially over its vertices in order (only when
 //            there are ordered includes: their rule is a walk, not a set);
-//   combine  per fiber: kept = length in range, every include reached, no
-//            exclude entered, the ordered includes entered in order.
+//   combine  per fiber: kept = length in range, every scalar in its range,
+//            every include reached, no exclude entered, the ordered
+//            includes entered in order.
 // Exclusion and inclusion are order-free (a vertex in a region is one
 // whatever came before), so only the ordered walk needs the vertices in
 // sequence; the hits pass runs over fiblets, 60 times more invocations
@@ -41,6 +42,8 @@ FILTER_CONST uint kFilterMask = 3u;         // v0..11 world -> voxel (3 rows of 
 FILTER_CONST uint kFilterMaxHitRegions = 64u;
 FILTER_CONST uint kFilterMaxOrderedRegions = 64u;
 FILTER_CONST uint kFilterGroupSize = 64u;  // invocations per workgroup of every filter pass
+// Scalar ranges (per-fiber values from the file, select/scalar_range.h).
+FILTER_CONST uint kFilterMaxScalarRanges = 16u;
 
 // One region on the device (std430: the 64-bit member first, then 4-byte
 // scalars only), 128 bytes.
@@ -59,6 +62,24 @@ struct FilterRegion {
   float box[6];
   uint pad2;
   uint pad3;
+};
+
+// One scalar range: `values` holds a float per scene fiber (indexed by the
+// scene-global fiber, fiber_base + f), kept when min <= value <= max
+// (filterScalarInRange); open ends are -inf / +inf.
+struct FilterScalarRange {
+  uint64_t values;
+  float min;
+  float max;
+};
+// The ranges of one update (the push constants are full: FilterPassPush
+// holds only this block's address, 0 without ranges).
+struct FilterScalarRanges {
+  FilterScalarRange ranges[kFilterMaxScalarRanges];
+  uint count;
+  uint pad0;
+  uint pad1;
+  uint pad2;
 };
 
 // Per fiber: x, y = the include / exclude regions one of its vertices lies
@@ -96,8 +117,7 @@ struct FilterPassPush {
   uint has_zone;
   float max_d2;
   float zone_radius;  // a sphere zone's radius (its distances are |p - c| - r)
-  uint pad0;
-  uint pad1;
+  uint64_t scalar_ranges;  // FilterScalarRanges (combine), 0: none
   uint64_t zone_d2;
   uint64_t zone_mm;
 };
@@ -133,6 +153,12 @@ SHADER_FN bool filterOrientedBoxContains(vec3 c, vec3 half_size, vec3 a0, vec3 a
   return filterAxisWithin(d, a0.x, a0.y, a0.z, half_size.x) && filterAxisWithin(d, a1.x, a1.y, a1.z, half_size.y) &&
          filterAxisWithin(d, a2.x, a2.y, a2.z, half_size.z);
 }
+
+// A per-fiber scalar against its range, the bounds as floats (min rounded
+// up, max rounded down from the doubles, so the float comparison is the
+// double one). A NaN value fails both comparisons: it is dropped, as a
+// fiber whose value is unknown cannot be said to lie in the range.
+SHADER_FN bool filterScalarInRange(float value, float lo, float hi) { return value >= lo && value <= hi; }
 
 // Distance to a zone (the fiblets paper's figure 11 e, f): the squared
 // distance from p to the zone's core, without a square root (whose GPU
@@ -179,7 +205,10 @@ SHADER_NAMESPACE_END
 static_assert(sizeof(fibscope::shader::FilterRegion) == 128, "a filter region is 128 bytes in std430");
 static_assert(offsetof(fibscope::shader::FilterRegion, v) == 32, "the floats follow the header");
 static_assert(sizeof(fibscope::shader::FilterPassPush) == 128, "");
+static_assert(offsetof(fibscope::shader::FilterPassPush, scalar_ranges) == 104, "");
 static_assert(offsetof(fibscope::shader::FilterPassPush, zone_d2) == 112, "");
+static_assert(sizeof(fibscope::shader::FilterScalarRange) == 16, "");
+static_assert(sizeof(fibscope::shader::FilterScalarRanges) == 16 * fibscope::shader::kFilterMaxScalarRanges + 16, "");
 #endif
 
 #endif  // FIBSCOPE_SHADERS_SHARED_FIBER_FILTER_H

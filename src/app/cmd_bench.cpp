@@ -109,6 +109,7 @@ void runBench(const BenchOptions& o) {
   scene_options.path = o.render.input;
   scene_options.phantom_streamlines = o.render.phantom_streamlines;
   scene_options.upload_raw = need_points;
+  scene_options.fiber_scalars = criteria.scalar_ranges;
   LoadedScene scene = loadScene(*context, scene_options);
   GpuScene gpu_scene = scene.gpuScene();
   for (Variant& v : variants) applyScalarColoring(*context, scene.fiblets, o.render, v.settings, gpu_scene);

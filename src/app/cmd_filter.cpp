@@ -14,6 +14,7 @@
 #include "core/progress.h"
 #include "io/writer.h"
 #include "select/filter_run.h"
+#include "select/scalar_range.h"
 
 namespace fibscope {
 namespace {
@@ -39,6 +40,8 @@ void runFilterCommand(const FilterOptions& o) {
   const auto start = std::chrono::steady_clock::now();
   auto reader = openInput(o.input);
   const FiberFilter filter(criteria, headerStepSize(reader->header()));
+  // Every scalar range's array in the input, before the output is made.
+  resolveScalarColumns(criteria.scalar_ranges, reader->header().per_streamline, o.input);
   WriterOptions wo;
   wo.overwrite = o.force;
   auto writer = createTractogramWriter(o.output, reader->header(), wo);
@@ -77,6 +80,7 @@ void runFilterCommand(const FilterOptions& o) {
   };
   if (!std::isnan(criteria.min_length_mm) || !std::isnan(criteria.max_length_mm) || r.by_length > 0)
     dropped("length", r.by_length);
+  for (size_t i = 0; i < r.by_scalar.size(); ++i) dropped(scalarRangeOutside(criteria.scalar_ranges[i]), r.by_scalar[i]);
   for (size_t i = 0; i < r.by_exclude.size(); ++i) dropped("entered " + named.exclude_names[i], r.by_exclude[i]);
   for (size_t i = 0; i < r.by_include.size(); ++i) dropped("missed " + named.include_names[i], r.by_include[i]);
   if (!criteria.include_ordered.empty()) dropped("missed the --include-ordered regions or their order", r.by_order);
@@ -89,7 +93,7 @@ void runFilterCommand(const FilterOptions& o) {
 void addFilterCommand(CLI::App& app) {
   auto o = std::make_shared<FilterOptions>();
   CLI::App* cmd = app.add_subcommand(
-      "filter", "Keep the streamlines that pass regions of interest and length limits (as MRtrix3's tckedit)");
+      "filter", "Keep the streamlines that pass regions of interest, length limits and per-streamline scalar ranges (regions and lengths as MRtrix3's tckedit)");
   cmd->add_option("input", o->input, "Input tractogram (.tck .trk .trx .vtk .fbl)")->required();
   cmd->add_option("output", o->output, "Output tractogram (.tck .trk .trx)")->required();
   addCriteriaCliOptions(cmd, o->criteria);

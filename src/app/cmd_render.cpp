@@ -95,6 +95,7 @@ void runRender(const RenderCommandOptions& o) {
   scene_options.path = o.render.input;
   scene_options.phantom_streamlines = o.render.phantom_streamlines;
   scene_options.upload_raw = settings.pipeline != RenderPipeline::Compute;
+  scene_options.fiber_scalars = criteria.scalar_ranges;
   LoadedScene scene = loadScene(waitForDevice, scene_options);
   const gpu::VulkanContext& context = waitForDevice();
 

@@ -12,10 +12,12 @@
 
 #include "app/commands.h"
 #include "app/criteria_options.h"
+#include "app/open_input.h"
 #include "app/viewer/dissection.h"
 #include "app/render_options.h"
 #include "app/viewer/viewer_app.h"
 #include "core/error.h"
+#include "select/scalar_range.h"
 #include "render/settings_table.h"
 
 namespace fibscope {
@@ -54,6 +56,14 @@ RoiSet startingDissection(const CriteriaCliOptions& o, const std::vector<std::st
   set.ends_only = set.ends_only || o.ends_only;
   if (!std::isnan(o.min_length)) set.min_length_mm = o.min_length;
   if (!std::isnan(o.max_length)) set.max_length_mm = o.max_length;
+  for (const std::string& spec : o.scalar_ranges) {
+    const ScalarRange range = parseScalarRange(spec);  // checked by criteriaFrom above
+    const int i = findScalarRange(set, range.name, range.component);
+    if (i >= 0)
+      set.scalar_ranges[size_t(i)] = RoiScalarRange{range, true};
+    else
+      set.scalar_ranges.push_back(RoiScalarRange{range, true});
+  }
   for (const std::string& spec : cut_meshes) {
     try {
       set.cut_meshes.push_back(RoiCutMesh{parseMeshCut(spec), true});
@@ -70,6 +80,15 @@ RoiSet startingDissection(const CriteriaCliOptions& o, const std::vector<std::st
 void runView(ViewCommandOptions o) {
   ViewerOptions v;
   v.dissection = startingDissection(o.render.criteria, o.render.cut_meshes);
+  // A scalar range's array in every file given (the headers alone), as
+  // `fibscope filter` checks it, before any window.
+  if (!v.dissection.scalar_ranges.empty())
+    for (const std::string& file : o.files) {
+      std::vector<ScalarRange> ranges;
+      for (const RoiScalarRange& r : v.dissection.scalar_ranges)
+        if (r.enabled) ranges.push_back(r.range);
+      resolveScalarColumns(ranges, openInput(file)->header().per_streamline, file);
+    }
   v.dim_dropped = o.render.dim_dropped;
   v.files = o.files;
   v.phantom_streamlines = o.render.phantom_streamlines;

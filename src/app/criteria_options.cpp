@@ -5,6 +5,7 @@
 #include "core/error.h"
 #include "select/number_list.h"
 #include "select/roi_set.h"
+#include "select/scalar_range.h"
 
 namespace fibscope {
 namespace {
@@ -38,6 +39,10 @@ void addCriteriaCliOptions(CLI::App* cmd, CriteriaCliOptions& o) {
                   "A zone: X,Y,Z (a point) or a sphere:, box: or obox: spec; each fiber's smallest distance to it "
                   "(mm, from any vertex) is measured: a threshold with --max-distance, a colour with --color scalar");
   cmd->add_option("--max-distance", o.max_distance, "Keep the fibers within this distance of --distance-to, mm");
+  cmd->add_option("--fiber-scalar", o.scalar_ranges,
+                  "NAME:MIN:MAX or NAME[K]:MIN:MAX: keep the streamlines whose per-streamline value NAME (a trk "
+                  "property, a TRX dps array; component K, default 0) lies in [MIN, MAX]; MIN or MAX empty for an "
+                  "open end (fa_mean:0.3:); a NaN value is dropped; repeatable");
   cmd->add_option("--roi-set", o.roi_set,
                   "A ROI set (JSON, as the viewer saves it): its enabled regions, ends-only flag and length limits "
                   "join the options here (whose regions come after its; whose length limits win)");
@@ -74,6 +79,13 @@ CliCriteria criteriaFrom(const CriteriaCliOptions& o) {
       throw Error("--max-distance: expected a distance >= 0 mm");
     if (!criteria.distance_zone) throw Error("--max-distance: needs --distance-to");
     criteria.max_distance_mm = o.max_distance;
+  }
+  for (const std::string& spec : o.scalar_ranges) {
+    try {
+      criteria.scalar_ranges.push_back(parseScalarRange(spec));
+    } catch (const Error& e) {
+      throw Error(std::string("--fiber-scalar ") + e.what());
+    }
   }
   if (!o.roi_set.empty()) {
     const RoiSet set = loadRoiSet(o.roi_set);

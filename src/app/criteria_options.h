@@ -1,7 +1,8 @@
 // The fiber filter's command-line options, one set for `fibscope filter`,
 // `render` and `bench` (the same criteria on the CPU and the GPU):
 // --include / --include-ordered / --exclude SPEC (select/region.h),
-// --ends-only, --min-length / --max-length MM, --roi-set FILE.json
+// --ends-only, --min-length / --max-length MM, --fiber-scalar
+// NAME[K]:MIN:MAX (select/scalar_range.h), --roi-set FILE.json
 // (select/roi_set.h: its enabled regions come first, the command line's
 // after them; the command line's length limits win).
 #pragma once
@@ -26,6 +27,7 @@ struct CriteriaCliOptions {
   // --distance-to X,Y,Z (a point) or a sphere/box/obox spec, --max-distance MM.
   std::string distance_to;
   double max_distance = NAN;
+  std::vector<std::string> scalar_ranges;  // --fiber-scalar specs (--scalar-range is the colormap's)
 };
 
 // The criteria, and a name for each include and exclude region (in the

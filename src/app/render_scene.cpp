@@ -39,6 +39,11 @@ LoadedScene loadScene(const ContextSource& device, const SceneOptions& options) 
     for (const std::string& warning : warnings) std::fprintf(stderr, "fibscope: warning: %s\n", warning.c_str());
   };
   const bool fbl = !options.path.empty() && isFblPath(options.path);
+  if (!options.fiber_scalars.empty()) {
+    // The arrays are checked first: a missing one is one line before any work.
+    const auto reader = open();
+    resolveScalarColumns(options.fiber_scalars, reader->header().per_streamline, scene.name);
+  }
 
   if (!fbl && !options.upload_raw) {
     // The compute pipeline alone: stream the input twice (estimate, then
@@ -55,6 +60,8 @@ LoadedScene loadScene(const ContextSource& device, const SceneOptions& options) 
     scene.encode_seconds = streamed.upload.encode_seconds;
     scene.upload_seconds = streamed.upload.upload_seconds;
     scene.step_size_mm = headerStepSize(open()->header());
+    // A third pass for the values alone (the stream kept no data arrays).
+    if (!options.fiber_scalars.empty()) scene.fiber_scalars = readScalarValues(*open(), options.fiber_scalars);
     return scene;
   }
 
@@ -69,6 +76,7 @@ LoadedScene loadScene(const ContextSource& device, const SceneOptions& options) 
   scene.sample = samplePoints(points);
   scene.streamlines = points.streamlineCount();
   scene.segments = segmentCount(points);
+  if (!options.fiber_scalars.empty()) scene.fiber_scalars = scalarValues(points, options.fiber_scalars, scene.name);
 
   if (fbl) {
     // Already fiblets: upload the records as stored (the decode above gave

@@ -16,6 +16,7 @@
 #include "render/gpu/frame_renderer.h"
 #include "render/gpu/raw_tractogram.h"
 #include "render/gpu/tractogram_upload.h"
+#include "select/scalar_range.h"
 
 namespace fibscope {
 
@@ -24,6 +25,9 @@ struct SceneOptions {
   uint64_t phantom_streamlines = 10000;  // built-in phantom size
   bool upload_raw = false;               // also upload the raw vertices (the baselines draw them)
   bool progress = true;                  // progress bars on a terminal
+  // The fiber filter's scalar ranges: their per-streamline values are read
+  // too (LoadedScene::fiber_scalars).
+  std::vector<ScalarRange> fiber_scalars;
 };
 
 struct LoadedScene {
@@ -34,6 +38,9 @@ struct LoadedScene {
   Bounds bounds;
   std::vector<Vec3d> sample;  // ~4096 of the points, to frame the view (snugCamera)
   uint64_t streamlines = 0, segments = 0;
+  // Per SceneOptions::fiber_scalars range, its value for every fiber (the
+  // scene's fibers are the file's streamlines, in order).
+  std::vector<std::vector<float>> fiber_scalars;
   float step_size_mm = NAN;  // the header's (select/fiber_filter.h: headerStepSize), NaN when it states none
   double read_seconds = 0, encode_seconds = 0, upload_seconds = 0;
 
@@ -42,7 +49,8 @@ struct LoadedScene {
 };
 
 // Reads, encodes and uploads. Throws Error naming the file for unreadable or
-// malformed input, and for a dataset that does not fit on the device.
+// malformed input, for a scalar range whose array the file lacks (before
+// anything else is read), and for a dataset that does not fit on the device.
 LoadedScene loadScene(const gpu::VulkanContext& context, const SceneOptions& options);
 // The same with the device made meanwhile (see ContextSource in
 // render/gpu/tractogram_upload.h): `context` is called when an upload

@@ -14,14 +14,15 @@ SceneFilter::SceneFilter(const gpu::VulkanContext& context, const LoadedScene& s
   const FilterFibletSource source{scene.fiblets.blockAddress(), block.fiblet_count, block.fiber_count, 0,
                                   scene.fiblets.fiberLength().address};
   fiblets_ = std::make_unique<GpuFiberFilter>(context);
-  fiblets_->update(filter, std::span(&source, 1), block.fiber_count);
+  fiblets_->update(filter, std::span(&source, 1), block.fiber_count, scene.fiber_scalars);
   gpu_ms_ = fiblets_->lastGpuMilliseconds();
   if (scene.has_raw) {
     // The raw vertices are the same fibers in the same order: the
     // dataset's lengths are theirs.
     raw_ = std::make_unique<GpuFiberFilter>(context);
     raw_->update(filter, FilterRawSource{scene.raw.blockAddress(), scene.raw.streamlineCount(), scene.raw.pointCount(),
-                                         scene.fiblets.fiberLength().address});
+                                         scene.fiblets.fiberLength().address},
+                 scene.fiber_scalars);
   }
 }
 

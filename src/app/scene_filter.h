@@ -20,7 +20,9 @@ class SceneFilter {
  public:
   SceneFilter() = default;
   // Evaluates `criteria` (nothing when empty) with the margin of the
-  // scene's step size. Throws Error as GpuFiberFilter::update does.
+  // scene's step size; its scalar ranges read scene.fiber_scalars (loaded
+  // with SceneOptions::fiber_scalars = the same ranges). Throws Error as
+  // GpuFiberFilter::update does.
   SceneFilter(const gpu::VulkanContext& context, const LoadedScene& scene, const FilterCriteria& criteria, bool dim);
 
   bool active() const { return fiblets_ != nullptr; }

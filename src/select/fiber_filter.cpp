@@ -1,6 +1,8 @@
 #include "select/fiber_filter.h"
 
 #include <algorithm>
+#include <cassert>
+#include <limits>
 #include <string>
 
 #include "core/error.h"
@@ -24,10 +26,26 @@ float lengthInFloat(const float* xyz, size_t n) {
   return total;
 }
 
+// The float nearest `bound` on the kept side (up for a min, down for a
+// max), so that a float value compares with it as with the double.
+float keptSideFloat(double bound, bool is_min) {
+  if (std::isnan(bound)) return is_min ? -INFINITY : INFINITY;
+  // Beyond a float's range (converting would be undefined): the float
+  // infinity on the bound's side, or the largest float on the kept side.
+  constexpr double kMax = std::numeric_limits<float>::max();
+  if (bound > kMax) return is_min ? INFINITY : float(kMax);
+  if (bound < -kMax) return is_min ? -float(kMax) : -INFINITY;
+  float f = float(bound);
+  if (is_min && double(f) < bound) f = std::nextafter(f, INFINITY);
+  if (!is_min && double(f) > bound) f = std::nextafter(f, -INFINITY);
+  return f;
+}
+
 }  // namespace
 
 bool FilterCriteria::empty() const {
-  return include.empty() && include_ordered.empty() && exclude.empty() && std::isnan(min_length_mm) &&
+  return include.empty() && include_ordered.empty() && exclude.empty() && scalar_ranges.empty() &&
+         std::isnan(min_length_mm) &&
          std::isnan(max_length_mm) && (!distance_zone || std::isnan(max_distance_mm));
 }
 
@@ -49,6 +67,13 @@ FiberFilter::FiberFilter(FilterCriteria criteria, float step_size_mm) : criteria
   for (const auto* list : {&criteria_.include, &criteria_.include_ordered, &criteria_.exclude})
     if (list->size() > kMaxRegions)
       throw Error("filter: at most " + std::to_string(kMaxRegions) + " regions of each kind");
+  if (criteria_.scalar_ranges.size() > kMaxScalarRanges)
+    throw Error("filter: at most " + std::to_string(kMaxScalarRanges) + " scalar ranges");
+  for (const ScalarRange& r : criteria_.scalar_ranges) {
+    checkScalarRange(r, "filter: scalar range " + scalarRangeSpec(r));
+    scalar_lo_.push_back(keptSideFloat(r.min, true));
+    scalar_hi_.push_back(keptSideFloat(r.max, false));
+  }
   const float margin = std::isfinite(step_size_mm) ? 0.1f * step_size_mm : 0.0f;
   if (!std::isnan(lo)) min_length_ = float(lo) - margin;
   if (!std::isnan(hi)) max_length_ = float(hi) + margin;
@@ -95,17 +120,25 @@ float FiberFilter::zoneDistance(const float* xyz, size_t n) const {
   return d > 0 ? d : 0.0f;
 }
 
-FilterVerdict FiberFilter::evaluate(const float* xyz, size_t n) const {
+FilterVerdict FiberFilter::evaluate(const float* xyz, size_t n, std::span<const float> scalars) const {
   // Without limits only "no points" counts (NaN, dropped as tckedit drops
   // an empty streamline), and summing a square root per point was a sixth
   // of `fibscope filter`'s time.
   const bool limited = min_length_ > -INFINITY || max_length_ < INFINITY;
-  return evaluate(xyz, n, limited ? lengthInFloat(xyz, n) : n == 0 ? NAN : 0.0f);
+  return evaluate(xyz, n, limited ? lengthInFloat(xyz, n) : n == 0 ? NAN : 0.0f, scalars);
 }
 
-FilterVerdict FiberFilter::evaluate(const float* xyz, size_t n, float length) const {
+int FiberFilter::scalarOutside(std::span<const float> scalars) const {
+  assert(scalars.size() == scalar_lo_.size());
+  for (size_t i = 0; i < scalar_lo_.size(); ++i)
+    if (!shader::filterScalarInRange(scalars[i], scalar_lo_[i], scalar_hi_[i])) return int(i);
+  return -1;
+}
+
+FilterVerdict FiberFilter::evaluate(const float* xyz, size_t n, float length, std::span<const float> scalars) const {
   if (n == 0) length = NAN;
   if (!(length >= min_length_ && length <= max_length_)) return {FilterReason::Length, 0};
+  if (const int r = scalarOutside(scalars); r >= 0) return {FilterReason::Scalar, uint32_t(r)};
   const FilterVerdict regions = evaluateRegions(xyz, n);
   if (!regions.kept()) return regions;
   if (has_zone_ && !(zoneDistance2(xyz, n) <= max_zone_d2_)) return {FilterReason::Distance, 0};

@@ -8,6 +8,9 @@
 //      m = 0.1 x the file's step size where the header states one
 //      ("output_step_size", else "step_size"), else 0 (tckedit's margin for
 //      lengths computed in float);
+//   1b. per-fiber scalars from the file (select/scalar_range.h; not a
+//      tckedit criterion): each range's value within [min, max] (open ends
+//      unbounded); a NaN value is dropped, whatever the range;
 //   2. the vertices (only the first and the last with ends_only), in order:
 //      one inside any exclude region drops the streamline; every include
 //      region must contain at least one vertex; the ordered includes must
@@ -21,11 +24,13 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "core/tractogram.h"
 #include "select/region.h"
+#include "select/scalar_range.h"
 #include "shared/fiber_filter.h"
 
 namespace fibscope {
@@ -45,16 +50,20 @@ struct FilterCriteria {
   // distances in float (shared/fiber_filter.h), alike on the CPU and GPU.
   std::optional<Region> distance_zone;
   double max_distance_mm = NAN;
+  // Per-fiber scalars in ranges (trk properties, TRX dps): the caller
+  // gives each streamline's values of these, in this order (evaluate's
+  // `scalars`; resolveScalarColumns finds them in a file's arrays).
+  std::vector<ScalarRange> scalar_ranges;
   // No criterion drops anything (a zone without a threshold drops nothing).
   bool empty() const;
 };
 
 // Why a streamline was dropped (Kept: it was not).
-enum class FilterReason : uint8_t { Kept, Length, Exclude, Include, IncludeOrdered, Distance };
+enum class FilterReason : uint8_t { Kept, Length, Scalar, Exclude, Include, IncludeOrdered, Distance };
 
 struct FilterVerdict {
   FilterReason reason = FilterReason::Kept;
-  uint32_t region = 0;  // Exclude / Include / IncludeOrdered: the region's index in its list
+  uint32_t region = 0;  // Exclude / Include / IncludeOrdered: the region's index in its list; Scalar: the range's
   bool kept() const { return reason == FilterReason::Kept; }
 };
 
@@ -65,17 +74,27 @@ float headerStepSize(const TractogramHeader& header);
 class FiberFilter {
  public:
   static constexpr size_t kMaxRegions = 64;  // of each kind
+  static constexpr size_t kMaxScalarRanges = shader::kFilterMaxScalarRanges;
   // Throws Error for a min length above the max length or a negative one,
-  // or more than kMaxRegions regions of a kind.
+  // more than kMaxRegions regions of a kind, a scalar range whose min is
+  // above its max, or more than kMaxScalarRanges of them.
   FiberFilter(FilterCriteria criteria, float step_size_mm = NAN);
   const FilterCriteria& criteria() const { return criteria_; }
 
-  // The verdict for the streamline of n points (x, y, z interleaved).
-  FilterVerdict evaluate(const float* xyz, size_t n) const;
+  // The verdict for the streamline of n points (x, y, z interleaved) whose
+  // per-fiber values of criteria().scalar_ranges are `scalars` (one per
+  // range, in their order: the caller must give exactly that many).
+  FilterVerdict evaluate(const float* xyz, size_t n, std::span<const float> scalars = {}) const;
   // The same with its length given (mm; NaN drops it) instead of summed
   // from the points: the GPU filter reads the lengths computed at upload,
   // and its tests compare with this.
-  FilterVerdict evaluate(const float* xyz, size_t n, float length_mm) const;
+  FilterVerdict evaluate(const float* xyz, size_t n, float length_mm, std::span<const float> scalars = {}) const;
+  // The index of the first range `scalars` misses, or -1 when in all.
+  int scalarOutside(std::span<const float> scalars) const;
+  // Range i's bounds as floats, as both sides compare them
+  // (shader::filterScalarInRange): -inf / +inf for an open end.
+  float scalarMin(size_t i) const { return scalar_lo_[i]; }
+  float scalarMax(size_t i) const { return scalar_hi_[i]; }
   // The length limits with the margin (-inf / +inf without a limit).
   float minLength() const { return min_length_; }
   float maxLength() const { return max_length_; }
@@ -105,6 +124,7 @@ class FiberFilter {
   void orderedStep(uint64_t among, const float* p, size_t& next, bool& in_order) const;
   static bool contains(const Packed& r, const float* p);
   float min_length_ = -INFINITY, max_length_ = INFINITY;  // with the margin
+  std::vector<float> scalar_lo_, scalar_hi_;
 };
 
 }  // namespace fibscope

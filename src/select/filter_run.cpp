@@ -25,6 +25,7 @@ void FilterReport::count(const FilterVerdict& v, uint64_t n) {
       kept_points += n;
       break;
     case FilterReason::Length: ++by_length; break;
+    case FilterReason::Scalar: ++by_scalar[v.region]; break;
     case FilterReason::Exclude: ++by_exclude[v.region]; break;
     case FilterReason::Include: ++by_include[v.region]; break;
     case FilterReason::IncludeOrdered: ++by_order; break;
@@ -42,6 +43,8 @@ void FilterReport::add(const FilterReport& o) {
   by_distance += o.by_distance;
   by_exclude.resize(std::max(by_exclude.size(), o.by_exclude.size()), 0);
   by_include.resize(std::max(by_include.size(), o.by_include.size()), 0);
+  by_scalar.resize(std::max(by_scalar.size(), o.by_scalar.size()), 0);
+  for (size_t i = 0; i < o.by_scalar.size(); ++i) by_scalar[i] += o.by_scalar[i];
   for (size_t i = 0; i < o.by_exclude.size(); ++i) by_exclude[i] += o.by_exclude[i];
   for (size_t i = 0; i < o.by_include.size(); ++i) by_include[i] += o.by_include[i];
 }
@@ -88,6 +91,9 @@ FilterReport runFilter(TractogramReader& reader, TractogramWriter& writer, const
   FilterReport report;
   report.by_exclude.assign(c.exclude.size(), 0);
   report.by_include.assign(c.include.size(), 0);
+  report.by_scalar.assign(c.scalar_ranges.size(), 0);
+  const std::string& path = reader.header().path;
+  resolveScalarColumns(c.scalar_ranges, reader.header().per_streamline, path);
   if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
 
   Tractogram chunks[2], kept;
@@ -107,9 +113,18 @@ FilterReport runFilter(TractogramReader& reader, TractogramWriter& writer, const
     const size_t n = chunk.streamlineCount();
     verdicts.assign(n, FilterVerdict{});
     const unsigned pieces = unsigned(std::min<size_t>(threads, std::max<size_t>(1, chunk.pointCount() / 65536)));
+    // The chunk's own arrays (their order is the reader's to choose).
+    const std::vector<ScalarColumn> columns = resolveScalarColumns(c.scalar_ranges, chunk.per_streamline, path);
     runPieces(pieces, [&](unsigned piece) {
-      for (size_t s = n * piece / pieces; s < n * (piece + 1) / pieces; ++s)
-        verdicts[s] = filter.evaluate(chunk.point(chunk.offsets[s]), chunk.pointsIn(s));
+      float scalars[FiberFilter::kMaxScalarRanges];
+      for (size_t s = n * piece / pieces; s < n * (piece + 1) / pieces; ++s) {
+        for (size_t r = 0; r < columns.size(); ++r) {
+          const DataArray& a = chunk.per_streamline[columns[r].array];
+          scalars[r] = a.values[s * a.components + columns[r].component];
+        }
+        verdicts[s] = filter.evaluate(chunk.point(chunk.offsets[s]), chunk.pointsIn(s),
+                                      std::span<const float>(scalars, columns.size()));
+      }
     });
     const uint64_t before = report.streamlines;  // input index of the chunk's first
     keep.assign(n, 0);

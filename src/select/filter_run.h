@@ -21,6 +21,7 @@ struct FilterReport {
   uint64_t streamlines = 0, points = 0;  // read
   uint64_t kept = 0, kept_points = 0;
   uint64_t by_length = 0;                // dropped by the length limits
+  std::vector<uint64_t> by_scalar;       // per scalar range: dropped for a value outside it (the first missed)
   std::vector<uint64_t> by_exclude;      // per exclude region: dropped by entering it
   std::vector<uint64_t> by_include;      // per include region: dropped for missing it (the first missed)
   uint64_t by_order = 0;                 // dropped for the ordered includes (missed or out of order)
@@ -39,8 +40,10 @@ struct FilterReport {
 // finishes). The groups of the reader's header become the kept members of
 // each at their output indices, in the group's order (writer.renumberGroups;
 // an empty group is dropped, as trx-python's select drops it). `progress` is called after each chunk with the reader's
-// bytes so far. `threads`: 0 = every core. Throws what the reader and the
-// writer throw.
+// bytes so far. `threads`: 0 = every core. The filter's scalar ranges
+// read the chunks' per-streamline arrays (resolveScalarColumns: an array
+// the reader does not give is an Error naming its path, before anything is
+// written). Throws what the reader and the writer throw.
 FilterReport runFilter(TractogramReader& reader, TractogramWriter& writer, const FiberFilter& filter,
                        unsigned threads = 0, const std::function<void(uint64_t bytes)>& progress = {});
 

@@ -27,6 +27,8 @@ std::optional<FilterReport> runTckFilterInPlace(const std::string& path, Tractog
                                                 const FiberFilter& filter, std::vector<std::string>& warnings,
                                                 unsigned threads, const std::function<void(uint64_t)>& progress,
                                                 uint64_t range_bytes) {
+  // A .tck carries no per-streamline values for scalar ranges to test.
+  if (!filter.criteria().scalar_ranges.empty()) return std::nullopt;
   TckHeaderInfo info;
   uint64_t file_bytes = 0;
   {
@@ -71,6 +73,7 @@ std::optional<FilterReport> runTckFilterInPlace(const std::string& path, Tractog
       r.report = FilterReport{};
       r.report.by_exclude.assign(c.exclude.size(), 0);
       r.report.by_include.assign(c.include.size(), 0);
+      r.report.by_scalar.assign(c.scalar_ranges.size(), 0);
       const uint64_t from = begin + (first + k) * range_bytes, to = std::min(end, from + range_bytes);
       TckStreamlineScan scan(*streams[k], begin, from, to);
       TckStreamlineScan::Step step;

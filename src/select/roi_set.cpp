@@ -127,6 +127,27 @@ Roi readRoi(const SetReader& r, const json& v, const std::string& place) {
   return roi;
 }
 
+RoiScalarRange readScalarRange(const SetReader& r, const json& v, const std::string& place) {
+  r.checkKeys(v, place, {"name", "component", "min", "max", "enabled"});
+  RoiScalarRange out;
+  out.range.name = r.string(r.require(v, place, "name"), place + ".name");
+  if (out.range.name.empty()) r.failAt(place + ".name", "empty (expected a per-streamline array's name)");
+  if (const json* c = r.find(v, "component")) {
+    if (!c->is_number_unsigned() || c->get<uint64_t>() > 65536)
+      r.failAt(place + ".component", "expected an integer from 0 to 65536, found " + oneLine(c->dump()));
+    out.range.component = c->get<uint32_t>();
+  }
+  for (const auto& [key, member] : {std::pair{"min", &out.range.min}, std::pair{"max", &out.range.max}})
+    if (const json* b = r.find(v, key)) {
+      *member = r.number(*b, place + "." + key);
+      if (!std::isfinite(*member)) r.failAt(place + "." + key, "not a finite number");
+    }
+  if (out.range.min > out.range.max)
+    r.failAt(place, "min " + oneLine(v["min"].dump()) + " is above max " + oneLine(v["max"].dump()));
+  if (const json* enabled = r.find(v, "enabled")) out.enabled = r.boolean(*enabled, place + ".enabled");
+  return out;
+}
+
 RoiClipPlane readClipPlane(const SetReader& r, const json& v, const std::string& place) {
   r.checkKeys(v, place, {"point", "normal", "enabled"});
   RoiClipPlane out;
@@ -254,8 +275,8 @@ RoiSet parseRoiSet(const std::string& text, const std::string& path) {
     r.failAt("fibscope_roi_set", "version " + oneLine(version->dump()) + " (this fibscope reads version " +
                                      std::to_string(kRoiSetVersion) + ")");
   r.checkKeys(doc, "",
-              {"fibscope_roi_set", "rois", "ends_only", "min_length_mm", "max_length_mm", "clip_planes", "slab",
-               "cut_meshes", "anatomy"});
+              {"fibscope_roi_set", "rois", "ends_only", "min_length_mm", "max_length_mm", "scalar_ranges",
+               "clip_planes", "slab", "cut_meshes", "anatomy"});
   RoiSet set;
   if (const json* rois = r.find(doc, "rois"))
     for (size_t i = 0; i < r.array(*rois, "rois").size(); ++i)
@@ -270,6 +291,15 @@ RoiSet parseRoiSet(const std::string& text, const std::string& path) {
   if (set.min_length_mm > set.max_length_mm)
     r.failAt("min_length_mm", "above max_length_mm (" + oneLine(doc["min_length_mm"].dump()) + " > " +
                                   oneLine(doc["max_length_mm"].dump()) + ")");
+  if (const json* ranges = r.find(doc, "scalar_ranges")) {
+    for (size_t i = 0; i < r.array(*ranges, "scalar_ranges").size(); ++i)
+      set.scalar_ranges.push_back(readScalarRange(r, (*ranges)[i], "scalar_ranges[" + std::to_string(i) + "]"));
+    const auto enabled = std::count_if(set.scalar_ranges.begin(), set.scalar_ranges.end(),
+                                       [](const RoiScalarRange& s) { return s.enabled; });
+    if (size_t(enabled) > FiberFilter::kMaxScalarRanges)
+      r.failAt("scalar_ranges", std::to_string(enabled) + " enabled (at most " +
+                                    std::to_string(FiberFilter::kMaxScalarRanges) + " at once)");
+  }
   if (const json* planes = r.find(doc, "clip_planes")) {
     for (size_t i = 0; i < r.array(*planes, "clip_planes").size(); ++i)
       set.clip_planes.push_back(readClipPlane(r, (*planes)[i], "clip_planes[" + std::to_string(i) + "]"));
@@ -319,6 +349,16 @@ std::string roiSetJson(const RoiSet& set, const std::string& path) {
   doc["ends_only"] = set.ends_only;
   if (!std::isnan(set.min_length_mm)) doc["min_length_mm"] = set.min_length_mm;
   if (!std::isnan(set.max_length_mm)) doc["max_length_mm"] = set.max_length_mm;
+  if (!set.scalar_ranges.empty()) {
+    doc["scalar_ranges"] = nlohmann::ordered_json::array();
+    for (const RoiScalarRange& s : set.scalar_ranges) {
+      nlohmann::ordered_json entry = {{"name", s.range.name}, {"component", s.range.component}};
+      if (!std::isnan(s.range.min)) entry["min"] = s.range.min;
+      if (!std::isnan(s.range.max)) entry["max"] = s.range.max;
+      entry["enabled"] = s.enabled;
+      doc["scalar_ranges"].push_back(std::move(entry));
+    }
+  }
   doc["clip_planes"] = nlohmann::ordered_json::array();
   for (const RoiClipPlane& p : set.clip_planes)
     doc["clip_planes"].push_back(
@@ -364,6 +404,8 @@ FilterCriteria filterCriteria(const RoiSet& set) {
   c.ends_only = set.ends_only;
   c.min_length_mm = set.min_length_mm;
   c.max_length_mm = set.max_length_mm;
+  for (const RoiScalarRange& s : set.scalar_ranges)
+    if (s.enabled) c.scalar_ranges.push_back(s.range);
   return c;
 }
 
@@ -387,6 +429,8 @@ FilterCriteria mergeCriteria(FilterCriteria set, const FilterCriteria& command_l
   set.ends_only = set.ends_only || command_line.ends_only;
   if (!std::isnan(command_line.min_length_mm)) set.min_length_mm = command_line.min_length_mm;
   if (!std::isnan(command_line.max_length_mm)) set.max_length_mm = command_line.max_length_mm;
+  set.scalar_ranges.insert(set.scalar_ranges.end(), command_line.scalar_ranges.begin(),
+                           command_line.scalar_ranges.end());
   // (A set holds no distance zone: the command line's is the only one.)
   set.distance_zone = command_line.distance_zone;
   set.max_distance_mm = command_line.max_distance_mm;

@@ -12,6 +12,10 @@
 //                 "enabled": true } ],                 // default true
 //     "ends_only": false,
 //     "min_length_mm": 20, "max_length_mm": 250,       // numbers >= 0; absent: no limit
+//     "scalar_ranges": [ { "name": "fa_mean",          // required: a per-streamline array
+//                          "component": 0,             // default 0
+//                          "min": 0.3, "max": 0.9,     // numbers, min <= max; absent: open
+//                          "enabled": true } ],        // at most kFilterMaxScalarRanges enabled
 //     "clip_planes": [ { "point": [x, y, z], "normal": [x, y, z],   // required; normal non-zero
 //                        "enabled": true } ],          // at most kMaxClipPlanes enabled
 //     "slab": { "thickness_mm": 5,                     // required, > 0
@@ -66,6 +70,11 @@ struct RoiClipPlane {
   bool enabled = true;
 };
 
+struct RoiScalarRange {
+  ScalarRange range;
+  bool enabled = true;
+};
+
 struct RoiCutMesh {
   MeshCut cut;  // cut.spec: a built-in shape or an OBJ path (resolved, see above)
   bool enabled = true;
@@ -76,6 +85,7 @@ struct RoiSet {
   bool ends_only = false;
   double min_length_mm = NAN;  // NaN: no limit
   double max_length_mm = NAN;
+  std::vector<RoiScalarRange> scalar_ranges;
   std::vector<RoiClipPlane> clip_planes;
   std::optional<Slab> slab;
   std::vector<RoiCutMesh> cut_meshes;
@@ -96,13 +106,15 @@ void saveRoiSet(const RoiSet& set, const std::string& path);
 std::string roiSetJson(const RoiSet& set, const std::string& path);
 
 // The criteria of the enabled ROIs (in their order within each role), the
-// ends-only flag and the length limits, for FiberFilter.
+// ends-only flag, the length limits and the enabled scalar ranges, for
+// FiberFilter.
 FilterCriteria filterCriteria(const RoiSet& set);
 // The enabled cuts.
 CutSet cutSet(const RoiSet& set);
 // A set's criteria with the command line's: its regions appended after the
 // set's, ends only where either asks, a length limit given on the command
-// line (not NaN) replacing the set's.
+// line (not NaN) replacing the set's, the command line's scalar ranges
+// after the set's.
 FilterCriteria mergeCriteria(FilterCriteria set, const FilterCriteria& command_line);
 
 // The path rules above, exposed for the tests: `path` joined to `folder`

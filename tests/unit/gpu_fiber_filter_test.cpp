@@ -2,8 +2,8 @@
 // bits equal the CPU filter's verdicts (select/fiber_filter.h, tckedit's
 // semantics) fiber for fiber, on the fiblets' decoded points (the CPU
 // decoder's sequential order) and on a raw tractogram's own points, for
-// spheres, boxes, oriented boxes, ends-only, ordered includes and length
-// limits; and the renderer draws only kept fibers in every pipeline, with
+// spheres, boxes, oriented boxes, ends-only, ordered includes, length
+// limits and per-fiber scalar ranges (with NaN values); and the renderer draws only kept fibers in every pipeline, with
 // two-phase culling still exact while the filter changes between frames.
 // Validation layers on (GpuTest fails on any message).
 #include <gtest/gtest.h>
@@ -27,6 +27,7 @@
 #include "select/fiber_filter.h"
 #include "select/gpu/gpu_fiber_filter.h"
 #include "select/region.h"
+#include "select/scalar_range.h"
 #include "select/voxel_mask.h"
 
 namespace fibscope {
@@ -234,6 +235,92 @@ TEST_F(GpuFiberFilterTest, keptBitsOfARawTractogramEqualTheCpuFilterOnTheFilesPo
     EXPECT_LT(kept, fibers_.streamlineCount());
     EXPECT_NE(filter_->keptPointBits(), 0u);
   }
+  gpu::destroyBuffer(context(), lengths);
+}
+
+// Per-fiber values for scalar ranges: "a" uniform in [0, 1) with every
+// 23rd NaN (dropped whatever the range), "b" a fiber's length in mm (so
+// its ranges correlate with the regions' cases), as the file's arrays.
+std::vector<std::vector<float>> fiberScalars(const std::vector<float>& lengths) {
+  std::vector<std::vector<float>> v(2);
+  uint32_t x = 12345;
+  for (size_t f = 0; f < lengths.size(); ++f) {
+    x = x * 1664525u + 1013904223u;
+    v[0].push_back(f % 23 == 4 ? NAN : float(x >> 8) / float(1 << 24));
+    v[1].push_back(lengths[f]);
+  }
+  return v;
+}
+
+// The cases of casesFor with scalar ranges added, and ranges alone.
+std::vector<Case> scalarCasesFor(const Bounds& b) {
+  const double ex = b.max[0] - b.min[0];
+  std::vector<Case> cases;
+  auto add = [&](std::string name, FilterCriteria c, std::vector<ScalarRange> ranges) {
+    c.scalar_ranges = std::move(ranges);
+    cases.push_back({std::move(name), std::move(c)});
+  };
+  add("a in [0.25, 0.75]", {}, {{"a", 0, 0.25, 0.75}});
+  add("a >= 0.5 (open max)", {}, {{"a", 0, 0.5, NAN}});
+  add("a open both ends (NaN dropped)", {}, {{"a", 0, NAN, NAN}});
+  add("b <= 0.6 x extent, a <= 0.9", {}, {{"b", 0, NAN, 0.6 * ex}, {"a", 0, NAN, 0.9}});
+  const std::vector<Case> regions = casesFor(b);
+  for (size_t i : {size_t(1), size_t(5), size_t(10), size_t(12)})
+    add(regions[i].name + ", a in [0.1, 0.8]", regions[i].criteria, {{"a", 0, 0.1, 0.8}});
+  return cases;
+}
+
+TEST_F(GpuFiberFilterTest, scalarRangesKeepTheFibersTheCpuFilterKeepsOnFibletsAndRawVertices) {
+  const std::vector<std::vector<float>> values = fiberScalars(lengths_);
+  const FilterFibletSource src = source();
+  const GpuRawTractogram raw = GpuRawTractogram::upload(context(), fibers_, "phantom");
+  gpu::Buffer lengths = gpu::createBuffer(context(), lengths_.size() * sizeof(float), gpu::MemoryUse::DeviceLocal);
+  gpu::uploadToBuffer(context(), lengths, lengths_.data(), lengths_.size() * sizeof(float));
+  const FilterRawSource raw_src{raw.blockAddress(), raw.streamlineCount(), raw.pointCount(), lengths.address};
+  auto cpuKept = [&](const FiberFilter& cpu, const Tractogram& points, std::vector<uint8_t>& kept) {
+    std::vector<float> scalars;
+    kept.assign(points.streamlineCount(), 0);
+    for (size_t f = 0; f < points.streamlineCount(); ++f) {
+      scalars.clear();
+      for (const ScalarRange& r : cpu.criteria().scalar_ranges) scalars.push_back(values[r.name == "a" ? 0 : 1][f]);
+      kept[f] = cpu.evaluate(points.point(points.offsets[f]), points.pointsIn(f), lengths_[f], scalars).kept();
+    }
+  };
+  for (const Case& c : scalarCasesFor(bounds_)) {
+    SCOPED_TRACE(c.name);
+    const FiberFilter cpu(c.criteria, 0.1f);
+    std::vector<std::vector<float>> used;
+    for (const ScalarRange& r : c.criteria.scalar_ranges) used.push_back(values[r.name == "a" ? 0 : 1]);
+    for (bool on_raw : {false, true}) {
+      SCOPED_TRACE(on_raw ? "raw vertices" : "fiblets");
+      ASSERT_TRUE(on_raw ? filter_->update(cpu, raw_src, used)
+                         : filter_->update(cpu, std::span(&src, 1), src.fibers, used));
+      const std::vector<uint32_t> words = filter_->keptWords();
+      std::vector<uint8_t> want;
+      cpuKept(cpu, on_raw ? fibers_ : decoded_, want);
+      size_t differ = 0, kept = 0;
+      for (size_t f = 0; f < want.size(); ++f) {
+        kept += want[f];
+        differ += bool(want[f]) != bitSet(words, f);
+      }
+      EXPECT_EQ(differ, 0u);
+      EXPECT_EQ(filter_->keptCount(), kept);
+      EXPECT_GT(kept, 0u);
+      EXPECT_LT(kept, fibers_.streamlineCount());
+    }
+  }
+  // The values' count must match the ranges and the fibers.
+  FilterCriteria c;
+  c.scalar_ranges = {{"a", 0, 0.2, 0.4}};
+  EXPECT_THROW(filter_->update(FiberFilter(c), std::span(&src, 1), src.fibers), Error);
+  const std::vector<std::vector<float>> short_values = {std::vector<float>(3, 0.3f)};
+  EXPECT_THROW(filter_->update(FiberFilter(c), std::span(&src, 1), src.fibers, short_values), Error);
+  // Other values for the same criteria: updated (the same ones again: not).
+  const std::vector<std::vector<float>> first = {values[0]}, second = {std::vector<float>(src.fibers, 0.3f)};
+  EXPECT_TRUE(filter_->update(FiberFilter(c), std::span(&src, 1), src.fibers, first));
+  EXPECT_FALSE(filter_->update(FiberFilter(c), std::span(&src, 1), src.fibers, first));
+  EXPECT_TRUE(filter_->update(FiberFilter(c), std::span(&src, 1), src.fibers, second));
+  EXPECT_EQ(filter_->keptCount(), src.fibers) << "every value 0.3 lies in [0.2, 0.4]";
   gpu::destroyBuffer(context(), lengths);
 }
 

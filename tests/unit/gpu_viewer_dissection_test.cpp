@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <glm/glm.hpp>
 #include <optional>
 #include <string>
@@ -418,6 +419,67 @@ TEST_F(GpuDissectionViewer, malformedRoiSetIsOneLineAndKeepsTheViewerAndItsState
   EXPECT_EQ(count(script + ":6: kept " + n_high + " of 300 fibers"), 1)
       << "the state outlived the bad files: " << r.output;
   EXPECT_EQ(count(script + ":7: expect-kept 999: " + n_high + " of 300 fibers are kept"), 1) << r.output;
+}
+
+// Per-fiber scalars: on a TRX whose dps holds "w" (some NaN), the scripted
+// ranges keep the count computed here from the array (and the ROI with
+// them), the count `fibscope filter --fiber-scalar` reports, and a saved
+// set holds the range.
+TEST_F(GpuDissectionViewer, scriptedFiberScalarRangesKeepWhatFibscopeFilterKeeps) {
+  Tractogram t = phantom_;
+  t.per_streamline = {{"w", 1, "float32", {}}};
+  uint32_t x = 99;
+  for (size_t s = 0; s < t.streamlineCount(); ++s) {
+    x = x * 1664525u + 1013904223u;
+    t.per_streamline[0].values.push_back(s % 29 == 3 ? NAN : float(x >> 8) / float(1 << 24));
+  }
+  const std::vector<float>& w = t.per_streamline[0].values;
+  const std::string trx = dir_.file("w.trx");
+  writeTractogram(trx, t, TractogramHeader{});
+  auto count = [&](double lo, double hi, bool with_roi) {
+    size_t n = 0;
+    for (size_t s = 0; s < t.streamlineCount(); ++s)
+      n += w[s] >= lo && w[s] <= hi && (!with_roi || closest(s, high_.center) <= high_.radius);
+    return n;
+  };
+  const size_t in_range = count(0.2, 0.7, false), with_roi = count(0.2, 0.7, true), open = count(0.5, INFINITY, true);
+  ASSERT_GT(with_roi, 0u);
+  ASSERT_LT(with_roi, in_range);
+  const auto filtered = test::runFibscope("filter " + trx + " " + dir_.file("f.trx") + " --fiber-scalar w:0.2:0.7");
+  ASSERT_EQ(filtered.exit_code, 0) << filtered.output;
+  EXPECT_NE(filtered.output.find(": " + std::to_string(in_range) + " of 300 streamlines kept"), std::string::npos)
+      << filtered.output;
+  const std::string script = dir_.file("w.txt"), set = dir_.file("w.json");
+  test::writeBytes(script, lines({
+                               "fiber-scalar w 0.2 0.7",
+                               "expect-kept " + std::to_string(in_range),
+                               "roi-add cst-high include " + high_.spec(),
+                               "expect-kept " + std::to_string(with_roi),
+                               "fiber-scalar w 0.5 -",
+                               "expect-kept " + std::to_string(open),
+                               "roi-save " + set,
+                               "fiber-scalar-clear",
+                               "expect-kept " + std::to_string(keptBy({high_}).size()),
+                               "quit",
+                           }));
+  const auto r = runViewer("--offscreen --size 160x120 --script " + script + " " + trx, dir_.file("cache"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const RoiSet saved = loadRoiSet(set);
+  ASSERT_EQ(saved.scalar_ranges.size(), 1u);
+  EXPECT_EQ(scalarRangeSpec(saved.scalar_ranges[0].range), "w:0.5:");
+}
+
+// A missing array: `render` names the file and its arrays, exit 2, no image.
+TEST(GpuScalarRangeCommand, renderWithAnArrayTheInputLacksIsOneLine) {
+  const auto info = test::runFibscope("gpu-info");
+  if (info.exit_code != 0) GTEST_SKIP() << "no usable Vulkan device: " << info.output;
+  test::TempDir dir;
+  const std::string tck = test::writePhantomTck(dir, "p.tck", 20, 1), png = dir.file("x.png");
+  const auto r = test::runFibscope("render " + tck + " -o " + png + " --fiber-scalar fa:0.3:");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+  EXPECT_NE(r.output.find(tck + ": no per-streamline array \"fa\""), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(png));
 }
 
 }  // namespace

@@ -575,5 +575,33 @@ TEST(ViewerDissection, aSetsSlabFollowsTheActiveSliceOfItsViewByTheImagesAxes) {
   EXPECT_EQ(anatomicalSliceAxis(ras, "oblique"), -1);
 }
 
+TEST(ViewerDissection, fiberScalarCommandsSetReplaceAndClearTheSetsRanges) {
+  DissectionState d;
+  RenderSettings s;
+  const auto steps = parseScript("fiber-scalar fa 0.3 -\nfiber-scalar rgb[2] - 10\nfiber-scalar fa 0.4 0.9\n"
+                                 "fiber-scalar-clear\n", "s");
+  ASSERT_EQ(steps.size(), 4u);
+  for (const auto& step : steps) edit(d, s, std::get<DissectionAction>(std::get<ViewerAction>(step.command)).edit);
+  EXPECT_TRUE(d.set.scalar_ranges.empty());
+  for (size_t i = 0; i < 3; ++i) edit(d, s, std::get<DissectionAction>(std::get<ViewerAction>(steps[i].command)).edit);
+  ASSERT_EQ(d.set.scalar_ranges.size(), 2u) << "the second fa replaced the first";
+  EXPECT_EQ(scalarRangeSpec(d.set.scalar_ranges[0].range), "fa:0.4:0.9");
+  EXPECT_EQ(scalarRangeSpec(d.set.scalar_ranges[1].range), "rgb[2]::10");
+  const FilterCriteria c = dissectionCriteria(d);
+  ASSERT_EQ(c.scalar_ranges.size(), 2u);
+  d.set.scalar_ranges[1].enabled = false;
+  EXPECT_EQ(dissectionCriteria(d).scalar_ranges.size(), 1u);
+  for (const char* bad : {"fiber-scalar fa x 1\n", "fiber-scalar fa 2 1\n", "fiber-scalar fa 1\n",
+                          "fiber-scalar-clear now\n"}) {
+    SCOPED_TRACE(bad);
+    const std::string e = test::errorOf([&] { parseScript(bad, "s.txt"); });
+    EXPECT_NE(e.find("s.txt:1: "), std::string::npos) << e;
+    EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+  }
+  edit(d, s, FiberScalarClearEdit{});
+  for (int i = 0; i < 16; ++i) edit(d, s, FiberScalarEdit{ScalarRange{"a" + std::to_string(i), 0, 0, 1}});
+  EXPECT_THROW(edit(d, s, FiberScalarEdit{ScalarRange{"one-too-many", 0, 0, 1}}), Error);
+}
+
 }  // namespace
 }  // namespace fibscope

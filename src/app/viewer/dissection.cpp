@@ -45,6 +45,17 @@ std::string uniqueRoiName(const RoiSet& set, const std::string& base) {
   }
 }
 
+int findScalarRange(const RoiSet& set, const std::string& name, uint32_t component) {
+  for (size_t i = 0; i < set.scalar_ranges.size(); ++i)
+    if (set.scalar_ranges[i].range.name == name && set.scalar_ranges[i].range.component == component) return int(i);
+  return -1;
+}
+
+size_t enabledScalarRanges(const RoiSet& set) {
+  return size_t(std::count_if(set.scalar_ranges.begin(), set.scalar_ranges.end(),
+                              [](const RoiScalarRange& r) { return r.enabled; }));
+}
+
 size_t enabledClipPlanes(const RoiSet& set) {
   return size_t(
       std::count_if(set.clip_planes.begin(), set.clip_planes.end(), [](const RoiClipPlane& p) { return p.enabled; }));
@@ -99,6 +110,19 @@ void applyDissectionEdit(DissectionState& state, RenderSettings& settings, const
           set.cut_meshes.push_back(RoiCutMesh{e.cut, true});
         } else if constexpr (std::is_same_v<E, CutMeshClearEdit>) {
           set.cut_meshes.clear();
+        } else if constexpr (std::is_same_v<E, FiberScalarEdit>) {
+          checkScalarRange(e.range, "fiber-scalar " + scalarRangeArray(e.range));
+          const int i = findScalarRange(set, e.range.name, e.range.component);
+          const bool was_enabled = i >= 0 && set.scalar_ranges[size_t(i)].enabled;
+          if (!was_enabled && enabledScalarRanges(set) >= FiberFilter::kMaxScalarRanges)
+            throw Error("fiber-scalar: at most " + std::to_string(FiberFilter::kMaxScalarRanges) +
+                        " scalar ranges at once");
+          if (i >= 0)
+            set.scalar_ranges[size_t(i)] = RoiScalarRange{e.range, true};
+          else
+            set.scalar_ranges.push_back(RoiScalarRange{e.range, true});
+        } else if constexpr (std::is_same_v<E, FiberScalarClearEdit>) {
+          set.scalar_ranges.clear();
         }
       },
       edit);

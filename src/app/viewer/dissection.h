@@ -34,6 +34,17 @@ struct DissectionStats {
   uint64_t kept = 0, fibers = 0;  // of the scene drawn (every visible model, or a baseline's one)
   double update_ms = 0;           // wall time of the last GPU update (submission to result)
   std::string error;              // criteria the GPU filter refused (everything is drawn then)
+  // The per-streamline arrays of the models drawn (each name once, with
+  // the most components a model has), for the panel's scalar ranges, and
+  // each component's smallest and largest finite value over the scene
+  // (lo > hi: none). A fiber of a model without a range's array has a
+  // NaN value: the range drops it.
+  struct ScalarArray {
+    std::string name;
+    uint32_t components = 1;
+    std::vector<float> lo, hi;  // per component
+  };
+  std::vector<ScalarArray> scalar_arrays;
 };
 
 struct DissectionState {
@@ -92,22 +103,32 @@ struct CutMeshAddEdit {
   MeshCut cut;
 };
 struct CutMeshClearEdit {};
+// A per-fiber scalar range, enabled: it replaces the set's range on the
+// same array and component, or is added after the others.
+struct FiberScalarEdit {
+  ScalarRange range;
+};
+struct FiberScalarClearEdit {};
 using DissectionEdit = std::variant<RoiAddEdit, RoiRemoveEdit, RoiEnableEdit, EndsOnlyEdit, LengthEdit,
                                     ClipPlaneAddEdit, ClipPlaneClearEdit, SlabEdit, DroppedEdit, CutMeshAddEdit,
-                                    CutMeshClearEdit>;
+                                    CutMeshClearEdit, FiberScalarEdit, FiberScalarClearEdit>;
 
 // Applies `edit` to the state (and, for the slab, to `settings`). Throws
 // Error (one line) and changes nothing for: a ROI name already used
 // (RoiAddEdit) or not found, no ROI selected for RoiRemoveEdit without a
 // name, a min length above the max or a negative one, a clip plane beyond
 // kMaxClipPlanes enabled ones, a cut mesh beyond kMaxCutMeshes enabled
-// ones, a negative or non-finite slab.
+// ones, a negative or non-finite slab, a scalar range whose min is above
+// its max or beyond FiberFilter::kMaxScalarRanges enabled ones.
 void applyDissectionEdit(DissectionState& state, RenderSettings& settings, const DissectionEdit& edit);
 
 // The first ROI named `name`, or -1.
 int findRoi(const RoiSet& set, const std::string& name);
 // `base` followed by the first "-N" (N = 1, 2, ...) no ROI is named yet.
 std::string uniqueRoiName(const RoiSet& set, const std::string& base);
+// The set's scalar range on this array and component, or -1.
+int findScalarRange(const RoiSet& set, const std::string& name, uint32_t component);
+size_t enabledScalarRanges(const RoiSet& set);
 // Enabled clip planes and cut meshes of the set.
 size_t enabledClipPlanes(const RoiSet& set);
 size_t enabledCutMeshes(const RoiSet& set);
@@ -117,7 +138,7 @@ inline constexpr size_t kMaxCutMeshes = shader::kMaxCutMeshes;
 // --- what the frame draws -------------------------------------------------
 
 // The fiber filter's criteria (roi_set.h's filterCriteria: enabled ROIs,
-// ends-only, lengths).
+// ends-only, lengths, enabled scalar ranges).
 FilterCriteria dissectionCriteria(const DissectionState& state);
 // Appends the set's enabled clip planes to settings.clip_planes as world
 // (n, d) planes (render/clip_planes.h's planeThrough), as many as fit in

@@ -624,6 +624,12 @@ void ViewerApp::dissect(FrameScene& scene, bool now) {
       d.raw = scene.gpu.raw;
       d.raw_lengths = first.fiblets.fiberLength().address;  // the raw vertices are its fibers, in order
     }
+    // The per-fiber values of the scalar ranges: each drawn model's .fbl.
+    for (const int m : scene.models) {
+      const ViewerModel& model = *scenes_[size_t(m)];
+      d.files.push_back(model.data ? &model.data->fbl : nullptr);
+      if (baseline) break;
+    }
   }
   try {
     finishFrame();  // an update rewrites the bits the frame in flight reads (and a sync frees meshes it may draw)

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cmath>
 #include <set>
 
 #include "app/open_input.h"
@@ -28,10 +29,34 @@ std::string criteriaKey(const FiberFilter& filter) {
   }
   char buf[64];
   std::snprintf(buf, sizeof buf, "|%d|%a|%a", int(c.ends_only), double(filter.minLength()), double(filter.maxLength()));
-  return key + buf;
+  key += buf;
+  for (size_t i = 0; i < c.scalar_ranges.size(); ++i) {
+    std::snprintf(buf, sizeof buf, "|%a,%a", double(filter.scalarMin(i)), double(filter.scalarMax(i)));
+    key += scalarRangeArray(c.scalar_ranges[i]) + buf;
+  }
+  return key;
+}
+
+// The values of `range` for every fiber of the scene: each file's
+// "dps/NAME" section at its entry's fiber base; NaN (dropped) for the
+// fibers of a model without that array or component.
+std::vector<float> sceneScalarValues(const DissectionScene& scene, uint32_t fibers, const ScalarRange& range) {
+  std::vector<float> values(fibers, NAN);
+  const std::string section = std::string(kFblSectionDpsPrefix) + range.name;
+  for (size_t i = 0; i < scene.files.size(); ++i) {
+    const FblFile* file = scene.files[i];
+    const FblSection* s = file ? file->find(section) : nullptr;
+    if (!s || range.component >= s->components) continue;
+    const std::span<const float> data = file->array<float>(*s);
+    const uint32_t base = scene.raw ? 0 : scene.layout->entries[i].fiber_base;
+    const uint64_t n = std::min<uint64_t>(data.size() / s->components, fibers - base);
+    for (uint64_t f = 0; f < n; ++f) values[base + f] = data[f * s->components + range.component];
+  }
+  return values;
 }
 
 std::string sceneKey(const DissectionScene& scene) {
+  if (!scene.raw && !scene.layout) return "";
   char buf[96];
   std::string key;
   if (scene.raw) {
@@ -123,6 +148,14 @@ bool isTrxPath(const std::string& path) {
 
 }  // namespace
 
+std::vector<DataArray> fblPerStreamlineArrays(const FblFile& file) {
+  std::vector<DataArray> out;
+  for (const FblSection& s : file.sections())
+    if (s.name.starts_with(kFblSectionDpsPrefix) && s.dtype == FblDType::kFloat32)
+      out.push_back({s.name.substr(kFblSectionDpsPrefix.size()), s.components, "float32", {}});
+  return out;
+}
+
 ViewerDissection::~ViewerDissection() {
   if (cancel_export_) cancel_export_->store(true);
   if (export_.valid()) export_.wait();
@@ -137,6 +170,32 @@ void ViewerDissection::evaluate(DissectionState& state, const DissectionScene& s
   DissectionStats& stats = state.stats;
   const FilterCriteria criteria = dissectionCriteria(state);
   const uint32_t fibers = scene.raw ? scene.raw->streamlineCount() : (scene.layout ? scene.layout->fibers : 0);
+  const std::string skey = sceneKey(scene);
+  if (skey != arrays_key_) {
+    // The panel's list: every model's arrays, each component's range of values.
+    stats.scalar_arrays.clear();
+    for (const FblFile* file : scene.files) {
+      if (!file) continue;
+      for (const DataArray& a : fblPerStreamlineArrays(*file)) {
+        auto it = std::find_if(stats.scalar_arrays.begin(), stats.scalar_arrays.end(),
+                               [&](const DissectionStats::ScalarArray& x) { return x.name == a.name; });
+        if (it == stats.scalar_arrays.end()) it = stats.scalar_arrays.insert(stats.scalar_arrays.end(), {a.name, 0, {}, {}});
+        it->components = std::max(it->components, a.components);
+        it->lo.resize(it->components, INFINITY);
+        it->hi.resize(it->components, -INFINITY);
+        const std::span<const float> data = file->array<float>(*file->find(std::string(kFblSectionDpsPrefix) + a.name));
+        for (size_t i = 0; i < data.size(); ++i) {
+          const float v = data[i];
+          if (!std::isfinite(v)) continue;
+          float& lo = it->lo[i % a.components];
+          float& hi = it->hi[i % a.components];
+          lo = std::min(lo, v);
+          hi = std::max(hi, v);
+        }
+      }
+    }
+    arrays_key_ = skey;
+  }
   stats.active = !criteria.empty();
   if (!stats.active) {
     // Nothing to filter: no GPU work, every fiber kept.
@@ -158,7 +217,7 @@ void ViewerDissection::evaluate(DissectionState& state, const DissectionScene& s
     criteria_key_.clear();
     return;
   }
-  const std::string skey = sceneKey(scene), ckey = criteriaKey(*filter_criteria);
+  const std::string ckey = criteriaKey(*filter_criteria);
   if (skey == scene_key_ && ckey == criteria_key_) {
     stats.evaluated = true;
     return;
@@ -192,14 +251,24 @@ void ViewerDissection::evaluate(DissectionState& state, const DissectionScene& s
   pending_key_.clear();
   raw_scene_ = scene.raw != nullptr;
   try {
+    // The ranges' values, read again only when the scene or the ranges' arrays change.
+    std::string values_key = skey;
+    for (const ScalarRange& r : criteria.scalar_ranges) values_key += "|" + scalarRangeArray(r);
+    if (values_key != scalars_key_) {
+      scalars_.clear();
+      for (const ScalarRange& r : criteria.scalar_ranges) scalars_.push_back(sceneScalarValues(scene, fibers, r));
+      scalars_key_ = values_key;
+    }
     if (scene.raw) {
-      filter(raw_).update(*filter_criteria, FilterRawSource{scene.raw->blockAddress(), scene.raw->streamlineCount(),
-                                                            scene.raw->pointCount(), scene.raw_lengths});
+      filter(raw_).update(*filter_criteria,
+                          FilterRawSource{scene.raw->blockAddress(), scene.raw->streamlineCount(),
+                                          scene.raw->pointCount(), scene.raw_lengths},
+                          scalars_);
     } else {
       std::vector<FilterFibletSource> sources;
       for (const SceneEntry& e : scene.layout->entries)
         sources.push_back({e.block, e.fiblets, e.fibers, e.fiber_base, e.dataset->fiberLength().address});
-      filter(fiblets_).update(*filter_criteria, sources, scene.layout->fibers);
+      filter(fiblets_).update(*filter_criteria, sources, scene.layout->fibers, scalars_);
     }
     failed_ = false;
     stats.error.clear();

@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "app/viewer/dissection.h"
+#include "codec/fbl_file.h"
 #include "gpu/vulkan_context.h"
 #include "phantom/phantom.h"
 #include "render/gpu/raw_tractogram.h"
@@ -40,6 +41,10 @@ struct DissectionScene {
   const GpuRawTractogram* raw = nullptr;  // a baseline's raw vertices (their streamlines are the fibers), or null
   VkDeviceAddress raw_lengths = 0;        // float per raw streamline (mm)
   float step_size_mm = NAN;               // for the length limits' margin (FiberFilter)
+  // The .fbl of each layout entry (raw: of the baseline's model alone), in
+  // the entries' order: their "dps/" sections are the per-fiber values of
+  // the scalar ranges. Null: a model without arrays.
+  std::vector<const FblFile*> files;
 };
 
 // The file an export streams: a loaded model's source.
@@ -98,6 +103,10 @@ class ViewerDissection {
   // What the bits are of: the scene and the criteria (keys), and when the
   // criteria were last seen to change.
   std::string scene_key_, criteria_key_, pending_key_;
+  // The scalar ranges' values over the scene (scalars[r][global fiber]) and
+  // the arrays listed for the panel, for the scene and ranges of the key.
+  std::vector<std::vector<float>> scalars_;
+  std::string scalars_key_, arrays_key_;
   std::chrono::steady_clock::time_point pending_since_;
   bool raw_scene_ = false;  // the bits are the raw filter's
   bool failed_ = false;     // the last update threw: nothing is filtered
@@ -105,6 +114,9 @@ class ViewerDissection {
   std::shared_ptr<std::atomic<bool>> cancel_export_;
   std::future<DissectionExportResult> export_;
 };
+
+// The per-streamline arrays of a .fbl (its "dps/" sections; values empty).
+std::vector<DataArray> fblPerStreamlineArrays(const FblFile& file);
 
 // The export's work without a thread (tests, the thread): the kept fibers
 // of `source` under `state`'s criteria to `path`, as runFilter writes them

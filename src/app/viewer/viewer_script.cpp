@@ -10,6 +10,7 @@
 #include "core/error.h"
 #include "select/cuts.h"
 #include "select/region.h"
+#include "select/scalar_range.h"
 
 namespace fibscope {
 namespace {
@@ -101,6 +102,22 @@ std::optional<ViewerAction> parseDissectionCommand(const std::vector<std::string
     const double lo = lengthLimit(w[1], "MIN"), hi = lengthLimit(w[2], "MAX");
     if (lo > hi) throw Error("length: MIN " + std::string(w[1]) + " lies above MAX " + std::string(w[2]));
     return ViewerAction{DissectionAction{LengthEdit{lo, hi}}};
+  }
+  if (name == "fiber-scalar") {
+    expectArguments(w, 3, 3, "fiber-scalar NAME[K] MIN|- MAX|-");
+    // The command line's spec, '-' for an open end.
+    auto bound = [](std::string_view word) { return word == "-" ? std::string() : std::string(word); };
+    ScalarRange range;
+    try {
+      range = parseScalarRange(std::string(w[1]) + ":" + bound(w[2]) + ":" + bound(w[3]));
+    } catch (const Error& e) {
+      throw Error(std::string("fiber-scalar: ") + e.what());
+    }
+    return ViewerAction{DissectionAction{FiberScalarEdit{range}}};
+  }
+  if (name == "fiber-scalar-clear") {
+    expectArguments(w, 0, 0, "fiber-scalar-clear");
+    return ViewerAction{DissectionAction{FiberScalarClearEdit{}}};
   }
   if (name == "clip-plane-add") {
     expectArguments(w, 1, 1, "clip-plane-add PX,PY,PZ,NX,NY,NZ");
@@ -264,7 +281,7 @@ std::variant<ViewerAction, WaitFrames, WaitLoaded, WaitExported> parseCommand(co
   throw Error("unknown command '" + std::string(name) +
               "' (expected orbit, pan, dolly, view, fov, set, wait, wait-loaded, open, model, screenshot, "
               "pick, clear-selection, export-selection, expect-selected, roi-add, roi-place, roi-remove, "
-              "roi-enable, ends-only, length, clip-plane-add, clip-plane-clear, cut-mesh-add, cut-mesh-clear, slab, "
+              "roi-enable, ends-only, length, fiber-scalar, fiber-scalar-clear, clip-plane-add, clip-plane-clear, cut-mesh-add, cut-mesh-clear, slab, "
               "dropped, roi-save, roi-load, "
               "export-kept, expect-kept, resize, anatomy or quit)");
 }

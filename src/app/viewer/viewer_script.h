@@ -23,6 +23,8 @@
 //   roi-place X Y              (a sphere on the fiber drawn at that window pixel: the right click)
 //   roi-remove NAME | roi-enable NAME on|off
 //   ends-only on|off | length MIN MAX   (mm, '-': no limit)
+//   fiber-scalar NAME[K] MIN MAX       (a per-fiber scalar's range, '-': open; replaces NAME[K]'s)
+//   fiber-scalar-clear                 (no scalar ranges)
 //   clip-plane-add PX,PY,PZ,NX,NY,NZ    (keeps the side the normal points to) | clip-plane-clear
 //   cut-mesh-add SPEC:inside|outside    (an OBJ path or box:/obox:/sphere:, select/cut_mesh.h; hides what lies
 //                              inside or outside it; a file that cannot be read is one line, nothing added)

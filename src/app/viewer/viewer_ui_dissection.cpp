@@ -1,5 +1,6 @@
 // The dissection panel (dissection.h): the ROIs with their roles, placed at
 // the focal point and edited numerically; ends only and length limits; the
+// models' per-fiber scalars, each with a range on or off; the
 // kept count and how dropped fibers are shown; clip planes, the slab and
 // mesh cuts (viewer_cuts.h);
 // saving and loading the ROI set; exporting the kept fibers. And the ROIs'
@@ -12,6 +13,7 @@
 #include <cstdio>
 #include <glm/glm.hpp>
 #include <string>
+#include <tuple>
 
 #include "app/viewer/viewer_ui.h"
 #include "core/error.h"
@@ -160,6 +162,74 @@ void lengthLimit(const char* label, double& value, double fallback) {
     ImGui::DragScalar("##mm", ImGuiDataType_Double, &value, 0.5f, &lo, &hi, "%.1f mm", ImGuiSliderFlags_AlwaysClamp);
   }
   ImGui::PopID();
+}
+
+// The per-streamline arrays of the models drawn, a row per component:
+// on/off, and when on, its [min, max] (started at the values' range); the
+// set's ranges on arrays no model drawn has are listed after them (their
+// fibers are all dropped: a missing value is NaN).
+void scalarRanges(DissectionState& d) {
+  RoiSet& set = d.set;
+  const auto& arrays = d.stats.scalar_arrays;
+  if (arrays.empty() && set.scalar_ranges.empty()) {
+    ImGui::TextDisabled("the models carry no per-fiber scalars");
+    return;
+  }
+  auto row = [&](const std::string& name, uint32_t k, float data_lo, float data_hi, bool present) {
+    const std::string label = k == 0 ? name : name + "[" + std::to_string(k) + "]";
+    ImGui::PushID(label.c_str());
+    const int i = findScalarRange(set, name, k);
+    bool on = i >= 0 && set.scalar_ranges[size_t(i)].enabled;
+    const bool full = !on && enabledScalarRanges(set) >= FiberFilter::kMaxScalarRanges;
+    ImGui::BeginDisabled(full);
+    if (ImGui::Checkbox(label.c_str(), &on)) {
+      if (i >= 0) {
+        set.scalar_ranges[size_t(i)].enabled = on;
+      } else {
+        const bool known = data_lo <= data_hi;
+        set.scalar_ranges.push_back(
+            RoiScalarRange{ScalarRange{name, k, known ? double(data_lo) : NAN, known ? double(data_hi) : NAN}, true});
+      }
+    }
+    ImGui::EndDisabled();
+    if (!present) {
+      ImGui::SameLine();
+      ImGui::TextColored(kWarning, "(no model drawn has it)");
+    } else if (data_lo <= data_hi) {
+      ImGui::SameLine();
+      ImGui::TextDisabled("%g .. %g", double(data_lo), double(data_hi));
+    }
+    const int j = findScalarRange(set, name, k);
+    if (on && j >= 0) {
+      ScalarRange& r = set.scalar_ranges[size_t(j)].range;
+      // An open end shows as unchecked; checked, it starts at the data's bound.
+      for (const auto& [what, bound, fallback] :
+           {std::tuple{"min", &r.min, double(data_lo)}, std::tuple{"max", &r.max, double(data_hi)}}) {
+        ImGui::PushID(what);
+        bool limited = !std::isnan(*bound);
+        ImGui::Indent();
+        if (ImGui::Checkbox(what, &limited)) *bound = limited ? (std::isfinite(fallback) ? fallback : 0.0) : NAN;
+        if (limited) {
+          ImGui::SameLine();
+          ImGui::SetNextItemWidth(-1);
+          const float speed = data_lo < data_hi ? float(data_hi - data_lo) / 200.0f : 0.01f;
+          ImGui::DragScalar("##v", ImGuiDataType_Double, bound, speed, nullptr, nullptr, "%.4g");
+        }
+        ImGui::Unindent();
+        ImGui::PopID();
+      }
+      if (r.min > r.max) r.max = r.min;  // min <= max, as the filter requires
+    }
+    ImGui::PopID();
+  };
+  for (const auto& a : arrays)
+    for (uint32_t k = 0; k < a.components; ++k) row(a.name, k, a.lo[k], a.hi[k], true);
+  for (const RoiScalarRange& r : std::vector<RoiScalarRange>(set.scalar_ranges)) {
+    const bool present = std::any_of(arrays.begin(), arrays.end(), [&](const auto& a) {
+      return a.name == r.range.name && r.range.component < a.components;
+    });
+    if (!present) row(r.range.name, r.range.component, INFINITY, -INFINITY, false);
+  }
 }
 
 // The mesh cuts: a spec typed (an OBJ path or a built-in shape) or a box or
@@ -331,6 +401,7 @@ void drawDissectionPanel(ViewerState& state, std::vector<ViewerAction>& actions)
         d.set.min_length_mm > d.set.max_length_mm)
       d.set.max_length_mm = d.set.min_length_mm;
   }
+  if (ImGui::CollapsingHeader("Per-fiber scalars", ImGuiTreeNodeFlags_DefaultOpen)) scalarRanges(d);
   if (ImGui::CollapsingHeader("Cuts", ImGuiTreeNodeFlags_DefaultOpen)) cutsSection(state, actions);
   if (ImGui::CollapsingHeader("Files", ImGuiTreeNodeFlags_DefaultOpen)) filesSection(state, actions);
   if (ImGui::CollapsingHeader("Mouse")) {

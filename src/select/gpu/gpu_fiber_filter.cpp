@@ -40,9 +40,35 @@ void setBit(uint32_t& lo, uint32_t& hi, uint32_t bit) { (bit < 32 ? lo : hi) |= 
 
 // The criteria and the sources, as text: update() does nothing when they
 // are those of the last time.
-std::string signatureOf(const FiberFilter& filter, const std::string& sources) {
+// The values as a key: their count and a 64-bit hash of their bits (the
+// vectors' addresses would not do: a freed vector's address comes back
+// with other values). Hashing is a few ms for ten million fibers, paid
+// only by an update() call, which callers make when something changed.
+std::string scalarKey(std::span<const std::vector<float>> scalars) {
+  std::string key;
+  for (const std::vector<float>& v : scalars) {
+    uint64_t h = 0x9E3779B97F4A7C15ull;
+    for (const float f : v) {
+      uint32_t bits;
+      std::memcpy(&bits, &f, 4);
+      h = (h ^ bits) * 0x100000001B3ull;
+    }
+    char buf[48];
+    std::snprintf(buf, sizeof buf, "%zu:%016llx;", v.size(), static_cast<unsigned long long>(h));
+    key += buf;
+  }
+  return key;
+}
+
+std::string signatureOf(const FiberFilter& filter, const std::string& sources,
+                        std::span<const std::vector<float>> scalars) {
   const FilterCriteria& c = filter.criteria();
-  std::string s = sources;
+  std::string s = sources + "|scalars " + scalarKey(scalars);
+  for (size_t i = 0; i < c.scalar_ranges.size(); ++i) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%a,%a;", double(filter.scalarMin(i)), double(filter.scalarMax(i)));
+    s += buf;
+  }
   for (const auto* list : {&c.include, &c.exclude, &c.include_ordered}) {
     s += '|';
     for (const Region& r : *list) s += regionSpec(r) + ';';
@@ -78,7 +104,9 @@ void GpuFiberFilter::release() {
   for (gpu::ComputePipeline* p : {&fiblet_hits_, &fiblet_ordered_, &raw_hits_, &raw_points_, &combine_})
     gpu::destroyComputePipeline(context_, *p);
   gpu::destroyGpuTimer(context_, timer_);
-  for (gpu::Buffer* b : {&regions_, &hits_, &kept_, &point_bits_, &zone_d2_, &zone_mm_}) gpu::destroyBuffer(context_, *b);
+  for (gpu::Buffer* b : {&regions_, &hits_, &kept_, &point_bits_, &zone_d2_, &zone_mm_, &scalar_values_, &scalar_ranges_})
+    gpu::destroyBuffer(context_, *b);
+  scalar_key_.clear();
   for (gpu::Buffer& b : masks_) gpu::destroyBuffer(context_, b);
   masks_.clear();
 }
@@ -91,8 +119,16 @@ void GpuFiberFilter::clear() {
   last_ms_ = 0;
 }
 
-void GpuFiberFilter::prepare(const FiberFilter& filter, uint32_t scene_fibers, uint64_t points, Packed& packed) {
+void GpuFiberFilter::prepare(const FiberFilter& filter, uint32_t scene_fibers, uint64_t points,
+                             std::span<const std::vector<float>> scalars, Packed& packed) {
   const FilterCriteria& c = filter.criteria();
+  if (scalars.size() != c.scalar_ranges.size())
+    throw Error("filter: " + std::to_string(c.scalar_ranges.size()) + " scalar ranges but values for " +
+                std::to_string(scalars.size()));
+  for (size_t r = 0; r < scalars.size(); ++r)
+    if (scalars[r].size() != scene_fibers)
+      throw Error("filter: " + std::to_string(scalars[r].size()) + " values of " + scalarRangeArray(c.scalar_ranges[r]) +
+                  " for " + std::to_string(scene_fibers) + " fibers");
   if (c.include.size() + c.exclude.size() > shader::kFilterMaxHitRegions)
     throw Error("filter: the GPU filter takes at most " + std::to_string(shader::kFilterMaxHitRegions) +
                 " include and exclude regions together");
@@ -146,6 +182,26 @@ void GpuFiberFilter::prepare(const FiberFilter& filter, uint32_t scene_fibers, u
       ensureBuffer(context_, zone_d2_, uint64_t(scene_fibers) * 4, gpu::MemoryUse::DeviceLocal);
       ensureBuffer(context_, zone_mm_, uint64_t(scene_fibers) * 4, gpu::MemoryUse::DeviceLocal);
     }
+    if (!scalars.empty()) {
+      // The values go up only when they changed: a ROI dragged in the
+      // viewer changes the criteria, not the file's values.
+      const std::string key = scalarKey(scalars);
+      const uint64_t per_range = uint64_t(scene_fibers) * 4;
+      if (key != scalar_key_ || scalar_values_.size < per_range * scalars.size()) {
+        scalar_key_.clear();
+        ensureBuffer(context_, scalar_values_, per_range * scalars.size(), gpu::MemoryUse::DeviceLocal);
+        for (size_t r = 0; r < scalars.size(); ++r)
+          gpu::uploadToBuffer(context_, scalar_values_, scalars[r].data(), per_range, per_range * r);
+        scalar_key_ = key;
+      }
+      shader::FilterScalarRanges block{};
+      block.count = uint32_t(scalars.size());
+      for (size_t r = 0; r < scalars.size(); ++r)
+        block.ranges[r] = {scalar_values_.address + per_range * r, filter.scalarMin(r), filter.scalarMax(r)};
+      ensureBuffer(context_, scalar_ranges_, sizeof block, gpu::MemoryUse::Upload);
+      std::memcpy(scalar_ranges_.mapped, &block, sizeof block);
+      push.scalar_ranges = scalar_ranges_.address;
+    }
   } catch (...) {
     clear();
     throw;
@@ -160,7 +216,7 @@ void GpuFiberFilter::prepare(const FiberFilter& filter, uint32_t scene_fibers, u
 
 
 bool GpuFiberFilter::update(const FiberFilter& filter, std::span<const FilterFibletSource> sources,
-                            uint32_t scene_fibers) {
+                            uint32_t scene_fibers, std::span<const std::vector<float>> scalars) {
   std::string where = "fiblets:" + std::to_string(scene_fibers);
   for (const FilterFibletSource& src : sources) {
     if (uint64_t(src.fiber_base) + src.fibers > scene_fibers)
@@ -170,7 +226,7 @@ bool GpuFiberFilter::update(const FiberFilter& filter, std::span<const FilterFib
                   static_cast<unsigned long long>(src.lengths));
     where += buf;
   }
-  const std::string signature = signatureOf(filter, where);
+  const std::string signature = signatureOf(filter, where, scalars);
   if (active_ && !raw_ && signature == signature_) {
     last_ms_ = 0;
     return false;
@@ -182,7 +238,7 @@ bool GpuFiberFilter::update(const FiberFilter& filter, std::span<const FilterFib
     return true;
   }
   Packed packed;
-  prepare(filter, scene_fibers, 0, packed);
+  prepare(filter, scene_fibers, 0, scalars, packed);
   gpu::submitOnce(context_, [&](VkCommandBuffer cmd) {
     gpu::resetGpuTimer(cmd, timer_);
     vkCmdFillBuffer(cmd, hits_.buffer, 0, VK_WHOLE_SIZE, 0);
@@ -217,9 +273,10 @@ bool GpuFiberFilter::update(const FiberFilter& filter, std::span<const FilterFib
   return true;
 }
 
-bool GpuFiberFilter::update(const FiberFilter& filter, const FilterRawSource& raw) {
+bool GpuFiberFilter::update(const FiberFilter& filter, const FilterRawSource& raw,
+                            std::span<const std::vector<float>> scalars) {
   const std::string signature =
-      signatureOf(filter, "raw:" + std::to_string(raw.block) + "," + std::to_string(raw.lengths));
+      signatureOf(filter, "raw:" + std::to_string(raw.block) + "," + std::to_string(raw.lengths), scalars);
   if (active_ && raw_ && signature == signature_) {
     last_ms_ = 0;
     return false;
@@ -231,7 +288,7 @@ bool GpuFiberFilter::update(const FiberFilter& filter, const FilterRawSource& ra
     return true;
   }
   Packed packed;
-  prepare(filter, raw.streamlines, std::max<uint64_t>(raw.points, 1), packed);
+  prepare(filter, raw.streamlines, std::max<uint64_t>(raw.points, 1), scalars, packed);
   packed.push.source = raw.block;
   packed.push.lengths = raw.lengths;
   packed.push.fiber_count = raw.streamlines;

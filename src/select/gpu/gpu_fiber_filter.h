@@ -10,7 +10,10 @@
 // bit for bit the CPU decoder's), a raw tractogram's float vertices (the
 // file's own). Lengths: the caller's per-fiber buffer (the dataset's
 // fiber_length_mm, the lengths uploaded with a raw tractogram), with
-// tckedit's margin from the filter.
+// tckedit's margin from the filter. Scalar ranges: the caller's per-fiber
+// values (the file's per-streamline arrays, one float per scene fiber and
+// range), uploaded when they change and tested in the combine pass with
+// the CPU's float bounds (FiberFilter::scalarMin / scalarMax).
 //
 // The passes run only when update() sees other criteria or other sources
 // than the last time, in one submission of their own between frames.
@@ -64,8 +67,16 @@ class GpuFiberFilter {
   // kFilterMaxHitRegions include and exclude regions together or
   // kFilterMaxOrderedRegions ordered ones, or when memory runs out (the
   // filter is then empty).
-  bool update(const FiberFilter& filter, std::span<const FilterFibletSource> sources, uint32_t scene_fibers);
-  bool update(const FiberFilter& filter, const FilterRawSource& raw);
+  //
+  // `scalars`: with scalar ranges, scalars[r] holds range r's value for
+  // every scene fiber (raw: every streamline), in the criteria's order.
+  // Values are uploaded again only when they differ from the last
+  // update's (compared by a hash of their bits). Throws
+  // Error when there are not as many vectors as ranges or a vector's size
+  // is not the fiber count.
+  bool update(const FiberFilter& filter, std::span<const FilterFibletSource> sources, uint32_t scene_fibers,
+              std::span<const std::vector<float>> scalars = {});
+  bool update(const FiberFilter& filter, const FilterRawSource& raw, std::span<const std::vector<float>> scalars = {});
   // Keeps everything again.
   void clear();
 
@@ -91,13 +102,16 @@ class GpuFiberFilter {
  private:
   struct Packed;
   void release();
-  void prepare(const FiberFilter& filter, uint32_t scene_fibers, uint64_t points, Packed& packed);
+  void prepare(const FiberFilter& filter, uint32_t scene_fibers, uint64_t points,
+               std::span<const std::vector<float>> scalars, Packed& packed);
   void finish();
 
   const gpu::VulkanContext& context_;
   gpu::ComputePipeline fiblet_hits_, fiblet_ordered_, raw_hits_, raw_points_, combine_;
   gpu::GpuTimer timer_;
   gpu::Buffer regions_, hits_, kept_, point_bits_, zone_d2_, zone_mm_;
+  gpu::Buffer scalar_values_, scalar_ranges_;  // a float per fiber and range; the FilterScalarRanges block
+  std::string scalar_key_;                     // the values scalar_values_ holds (a hash)
   bool has_zone_ = false;
   std::vector<gpu::Buffer> masks_;  // the voxel bits of mask regions
   std::string signature_;           // criteria and sources of the last update
