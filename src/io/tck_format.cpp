@@ -317,8 +317,10 @@ size_t TrackDataStream::fill(size_t n) {
   std::memmove(bytes(), bytes() + head_, available());
   tail_ -= head_;
   head_ = 0;
-  while (tail_ < capacity_ && next_ < end_) {
-    const size_t want = static_cast<size_t>(std::min<uint64_t>(capacity_ - tail_, end_ - next_));
+  // Up to the soft end as much as fits; past it only what was asked for.
+  while (tail_ < capacity_ && next_ < end_ && (next_ < soft_end_ || tail_ - head_ < n)) {
+    const uint64_t until = std::min(end_, next_ < soft_end_ ? soft_end_ : next_ + kPastSoftEnd);
+    const size_t want = static_cast<size_t>(std::min<uint64_t>(capacity_ - tail_, until - next_));
     const ssize_t got = ::pread(fd_, bytes() + tail_, want, static_cast<off_t>(next_));
     if (got < 0) {
       if (errno == EINTR) continue;

@@ -137,7 +137,13 @@ class TrackDataStream {
   size_t capacity() const { return capacity_; }
   // Forgets the buffered bytes and goes on reading at `position` (in
   // [begin, end)), keeping the buffer: a scan of many ranges of one file.
-  void restart(uint64_t position) { head_ = tail_ = 0, next_ = position; }
+  // Reads ahead stop at `soft_end` (a range's end) and go past it a little
+  // at a time (kPastSoftEnd: the streamline that crosses it), so ranges
+  // read their own bytes and hardly any of the next one's.
+  void restart(uint64_t position, uint64_t soft_end) {
+    head_ = tail_ = 0, next_ = position, soft_end_ = soft_end;
+  }
+  static constexpr size_t kPastSoftEnd = size_t(16) << 10;
   size_t fill(size_t n);
 
  private:
@@ -154,6 +160,7 @@ class TrackDataStream {
   size_t capacity_ = 0;
   uint64_t next_ = 0;  // file offset of buffer_[tail_]
   uint64_t end_ = 0;
+  uint64_t soft_end_ = UINT64_MAX;  // see restart()
 };
 
 // The warning a reader gives when the header's count line is missing or

@@ -31,7 +31,7 @@ TckStreamlineScan::TckStreamlineScan(TrackDataStream& data, uint64_t data_begin,
     : data_(data), stop_(stop), started_(begin == data_begin) {
   // A range after the first reads from the triplet before it: when that is
   // a separator, a streamline starts right at `begin`.
-  data_.restart(begin > data_begin ? begin - kTriplet : begin);
+  data_.restart(begin > data_begin ? begin - kTriplet : begin, stop);
 }
 
 size_t TckStreamlineScan::findSeparator() {
