@@ -52,7 +52,7 @@ struct TubeNode {
 struct TubeSegment {
   uint node;     // index of the first node in the node records
   uint fiber;    // the fiber's id (G-buffer fiber field, picking)
-  float length;  // chord length |P1 - P0| in mm: the Hermite end derivatives are length * tangent
+  float chord;   // chord length |P1 - P0| in mm: the Hermite end derivatives are length * tangent
   uint pad0;
 };
 
@@ -65,16 +65,16 @@ struct TubeQuadratic {
   vec4 b2;
 };
 
-// Sub-segment `half` (0: u in [0, 1/2], 1: u in [1/2, 1]) of the Hermite
-// segment from node a to node b of chord length `length`. The two inner
+// Sub-segment `which_half` (0: u in [0, 1/2], 1: u in [1/2, 1]) of the Hermite
+// segment from node a to node b of chord length `chord`. The two inner
 // control points are the Hermite's end points moved a quarter of the end
 // derivatives inward and the join is their midpoint, which is the cubic's
 // own point at u = 1/2: so the pair passes through both nodes with the
 // node tangents' directions (C1 along a tube, since neighbouring segments
 // share the node's derivative) and through the cubic's midpoint. Radius
 // the same way from dr/ds.
-SHADER_FN TubeQuadratic tubeQuadratic(TubeNode a, TubeNode b, float length, uint half) {
-  SHADER_PRECISE float q = 0.25f * length;
+SHADER_FN TubeQuadratic tubeQuadratic(TubeNode a, TubeNode b, float chord, uint which_half) {
+  SHADER_PRECISE float q = 0.25f * chord;
   SHADER_PRECISE vec3 p0 = vec3(a.position_radius.x, a.position_radius.y, a.position_radius.z);
   SHADER_PRECISE vec3 p1 = vec3(b.position_radius.x, b.position_radius.y, b.position_radius.z);
   SHADER_PRECISE vec3 c0 = p0 + vec3(a.tangent_dradius.x, a.tangent_dradius.y, a.tangent_dradius.z) * q;
@@ -86,7 +86,7 @@ SHADER_FN TubeQuadratic tubeQuadratic(TubeNode a, TubeNode b, float length, uint
   SHADER_PRECISE float rc1 = r1 - b.tangent_dradius.w * q;
   SHADER_PRECISE float rm = (rc0 + rc1) * 0.5f;
   TubeQuadratic out_q;
-  if (half == 0u) {
+  if (which_half == 0u) {
     out_q.b0 = vec4(p0, r0);
     out_q.b1 = vec4(c0, rc0);
     out_q.b2 = vec4(m, rm);

@@ -61,7 +61,7 @@ size_t propagateTubeFrames(shader::TubeNode* nodes, const shader::TubeSegment* s
     } else {
       // Sub-steps along the Hermite curve, its own tangents in between.
       const size_t steps = size_t(std::ceil(std::acos(c) / std::acos(cos_limit)));
-      const float length = segments[i].length;
+      const float length = segments[i].chord;
       const glm::vec3 m0 = length * t0, m1 = length * t1;
       glm::vec3 xa = x0, ta = t0;
       for (size_t k = 1; k <= steps; ++k) {

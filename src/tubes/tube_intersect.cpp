@@ -200,7 +200,7 @@ TubeRayHit intersectTubeQuadraticBruteForce(const shader::TubeQuadratic& q, cons
 
 shader::TubeQuadratic tubeSubSegment(const TubeModel& model, uint32_t index) {
   const shader::TubeSegment& s = model.segments[index / 2];
-  return shader::tubeQuadratic(model.nodes[s.node], model.nodes[s.node + 1], s.length, index % 2);
+  return shader::tubeQuadratic(model.nodes[s.node], model.nodes[s.node + 1], s.chord, index % 2);
 }
 
 size_t TubeReferenceImage::covered() const {

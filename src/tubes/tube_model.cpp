@@ -104,8 +104,8 @@ void segmentEnds(const TubeModel& model, const shader::TubeSegment& s, glm::vec3
   const shader::TubeNode& b = model.nodes[s.node + 1];
   p0 = {a.position_radius.x, a.position_radius.y, a.position_radius.z};
   p1 = {b.position_radius.x, b.position_radius.y, b.position_radius.z};
-  m0 = s.length * glm::vec3(a.tangent_dradius.x, a.tangent_dradius.y, a.tangent_dradius.z);
-  m1 = s.length * glm::vec3(b.tangent_dradius.x, b.tangent_dradius.y, b.tangent_dradius.z);
+  m0 = s.chord * glm::vec3(a.tangent_dradius.x, a.tangent_dradius.y, a.tangent_dradius.z);
+  m1 = s.chord * glm::vec3(b.tangent_dradius.x, b.tangent_dradius.y, b.tangent_dradius.z);
 }
 }  // namespace
 
@@ -294,7 +294,7 @@ TubeModel buildTubes(const Tractogram& tractogram, const TubeBuildOptions& optio
       shader::TubeSegment s{};
       s.node = tube.first_node + uint32_t(j);
       s.fiber = f;
-      s.length = chord[j];
+      s.chord = chord[j];
       model.segments.push_back(s);
     }
     if (m == 1) ++stats.single_point_tubes;

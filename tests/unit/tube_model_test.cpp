@@ -59,10 +59,10 @@ TEST(TubeModel, hermiteSegmentsPassThroughTheirNodesWithTheNodeDerivatives) {
     const shader::TubeNode &a = model.nodes[s.node], &b = model.nodes[s.node + 1];
     EXPECT_LT(glm::distance(tubeSegmentPoint(model, s, 0.0f), nodePosition(a)), 1e-5f);
     EXPECT_LT(glm::distance(tubeSegmentPoint(model, s, 1.0f), nodePosition(b)), 1e-5f);
-    EXPECT_NEAR(s.length, glm::distance(nodePosition(a), nodePosition(b)), 1e-5f);
+    EXPECT_NEAR(s.chord, glm::distance(nodePosition(a), nodePosition(b)), 1e-5f);
     // The derivative is the node tangent (per mm) times the chord, and a
     // finite difference of the curve agrees with it.
-    const glm::vec3 m0 = s.length * nodeTangent(a), m1 = s.length * nodeTangent(b);
+    const glm::vec3 m0 = s.chord * nodeTangent(a), m1 = s.chord * nodeTangent(b);
     EXPECT_LT(glm::distance(tubeSegmentDerivative(model, s, 0.0f), m0), 1e-5f);
     EXPECT_LT(glm::distance(tubeSegmentDerivative(model, s, 1.0f), m1), 1e-5f);
     // (Central differences: the cubic extends past [0, 1].)
@@ -200,7 +200,7 @@ TEST(TubeFrames, subStepsFollowTheDenseRotationMinimisingFrameAcrossATightTurn) 
   // Chords turning by 80 - 100 degrees, out of any one plane.
   std::vector<float> xyz;
   glm::vec3 p(0.0f);
-  for (const glm::vec3 d : {glm::vec3(1, 0, 0), glm::vec3(1, 0, 0), glm::vec3(0, 1, 0.3f), glm::vec3(-1, 0.2f, 0.5f),
+  for (const glm::vec3& d : {glm::vec3(1, 0, 0), glm::vec3(1, 0, 0), glm::vec3(0, 1, 0.3f), glm::vec3(-1, 0.2f, 0.5f),
                             glm::vec3(0, -1, 0.6f), glm::vec3(1, 0, 0.4f), glm::vec3(1, 0, 0)}) {
     xyz.insert(xyz.end(), {p.x, p.y, p.z});
     p += glm::normalize(d);
