@@ -64,5 +64,6 @@ void main() {
       const uint tile = ty * pc.tiles_x + tx;
       const uint slot = atomicAdd(CountsRef(pc.tile_counts).counts[tile], 1u);
       if (slot < kTubeTileCapacity) ListsRef(pc.tile_lists).items[tile * kTubeTileCapacity + slot] = item;
+      if (slot == kTubeTileCapacity) atomicAdd(CountsRef(pc.tile_counts).counts[pc.tiles_x * pc.tiles_y], 1u);
     }
 }

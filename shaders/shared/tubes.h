@@ -27,10 +27,12 @@
 SHADER_NAMESPACE_BEGIN
 
 // Screen tiles of the compute ray caster (kTubeTileSize^2 pixels, one
-// workgroup each) and the sub-segments a tile's list holds; a tile whose
-// count exceeds it tests every sub-segment instead (slow, never wrong).
+// workgroup each) and the sub-segments a tile's list holds (4 KiB a tile:
+// 33 MB of lists at 1920 x 1080); a tile whose count exceeds it tests every
+// sub-segment instead (slow, never wrong), and is counted
+// (FrameStats::tube_tiles_overflowed).
 TUBE_CONST uint kTubeTileSize = 16u;
-TUBE_CONST uint kTubeTileCapacity = 256u;
+TUBE_CONST uint kTubeTileCapacity = 1024u;
 // Sub-segments per workgroup of the binning pass.
 TUBE_CONST uint kTubeBinGroupSize = 64u;
 // The colour slope of a node (TubeNode::color_slope) is stored as
@@ -106,7 +108,7 @@ struct TubeBinPush {
   uint64_t camera;       // CameraBlock
   uint64_t nodes;        // TubeNode[]
   uint64_t segments;     // TubeSegment[]
-  uint64_t tile_counts;  // uint per tile, cleared to 0 before the pass
+  uint64_t tile_counts;  // uint per tile, then the count of overflowing tiles; cleared to 0 before the pass
   uint64_t tile_lists;   // uint[tiles * kTubeTileCapacity]: sub-segment indices
   uint sub_segments;     // 2 * segments
   uint tiles_x;

@@ -303,6 +303,7 @@ TubeModel buildTubes(const Tractogram& tractogram, const TubeBuildOptions& optio
     model.tubes.push_back(tube);
   }
   stats.nodes = model.nodes.size();
+  stats.tubes = model.tubes.size();
   if (stats_out) *stats_out = stats;
   return model;
 }

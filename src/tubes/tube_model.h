@@ -63,6 +63,7 @@ struct TubeBuildOptions {
 };
 
 struct TubeBuildStats {
+  size_t tubes = 0;               // tubes made (fibers with at least one point)
   size_t input_points = 0;        // points of the fibers given
   size_t nodes = 0;               // nodes made (= input_points without resampling)
   size_t invalid_radii = 0;       // NaN / infinite data values that took radius_min

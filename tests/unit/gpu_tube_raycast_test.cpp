@@ -34,13 +34,15 @@ class GpuTubeRaycast : public test::GpuTest {
  protected:
   // The surface target of one frame of `model` (setup and the tube stage
   // only).
-  std::vector<shader::SurfaceTexel> castOnGpu(const TubeModel& model, const Camera& camera) {
+  std::vector<shader::SurfaceTexel> castOnGpu(const TubeModel& model, const Camera& camera,
+                                              FrameStats* stats = nullptr) {
     GpuTubes tubes = uploadTubes(context(), model);
     std::vector<shader::SurfaceTexel> surface;
     try {
       // The compute pipeline's frame over no datasets: no geometry stage.
       FrameRenderer renderer(context(), camera.width, camera.height, {makeSetupStage, tubeRaycastStage(&tubes)});
-      renderer.render(camera, RenderSettings(), GpuScene());
+      const FrameStats frame = renderer.render(camera, RenderSettings(), GpuScene());
+      if (stats) *stats = frame;
       surface = downloadSurface(context(), renderer.targets());
     } catch (...) {
       destroyTubes(context(), tubes);
@@ -98,7 +100,9 @@ TEST_F(GpuTubeRaycast, computeRayCastingMatchesTheCpuReferenceOnCurvedTubes) {
     const TubeModel model = buildTubes(scene.tractogram, scene.options);
     for (const Camera& camera : test::tubeSceneCameras(scene, 120, 90)) {
       const TubeReferenceImage ref = renderReferenceTubes(model, camera, TubeReferenceMethod::Cascade);
-      const Agreement a = compare(castOnGpu(model, camera), ref, camera);
+      FrameStats stats;
+      const Agreement a = compare(castOnGpu(model, camera, &stats), ref, camera);
+      EXPECT_EQ(stats.tube_tiles_overflowed, 0u);
       const std::string what = scene.name + " from (" + std::to_string(camera.eye[0]) + ", " +
                                std::to_string(camera.eye[1]) + ", " + std::to_string(camera.eye[2]) + "): " +
                                a.summary();
@@ -112,12 +116,12 @@ TEST_F(GpuTubeRaycast, computeRayCastingMatchesTheCpuReferenceOnCurvedTubes) {
   }
 }
 
-// 120 short tubes piled in the same few tiles: up to 480 sub-segments a tile,
-// past kTubeTileCapacity, so those tiles test every sub-segment.
+// 300 short tubes piled in the same few tiles: up to 1,200 sub-segments a
+// tile, past kTubeTileCapacity, so those tiles test every sub-segment.
 TEST_F(GpuTubeRaycast, tilesWhoseListsOverflowStillDrawEveryTube) {
   Tractogram t;
-  for (int i = 0; i < 120; ++i) {
-    const float a = float(i) * 0.05f, z = float(i) * 0.02f;
+  for (int i = 0; i < 300; ++i) {
+    const float a = float(i) * 0.02f, z = float(i) * 0.008f;
     const float xyz[] = {-2.0f * std::cos(a), -2.0f * std::sin(a), z, 0.0f, 0.3f * std::sin(3.0f * a), z,
                          2.0f * std::cos(a), 2.0f * std::sin(a), z};
     t.addStreamline(xyz, 3);
@@ -129,7 +133,9 @@ TEST_F(GpuTubeRaycast, tilesWhoseListsOverflowStillDrawEveryTube) {
   Bounds b = tractogramBounds(t);
   const Camera camera = fitCamera(b, {0.2, -0.3, 1}, {0, 1, 0}, 48, 48);
   const TubeReferenceImage ref = renderReferenceTubes(model, camera, TubeReferenceMethod::Cascade);
-  const Agreement a = compare(castOnGpu(model, camera), ref, camera);
+  FrameStats stats;
+  const Agreement a = compare(castOnGpu(model, camera, &stats), ref, camera);
+  EXPECT_GT(stats.tube_tiles_overflowed, 0u);
   EXPECT_GT(a.both, 300u) << a.summary();
   EXPECT_GE(a.agreement(), 0.98) << a.summary();
   EXPECT_LE(a.fiber_mismatch, a.both / 50) << a.summary();  // tubes overlapping within float depth

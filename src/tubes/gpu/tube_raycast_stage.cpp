@@ -18,6 +18,7 @@ class TubeRaycastStage final : public FrameStage {
  public:
   explicit TubeRaycastStage(const GpuTubes* tubes) : tubes_(tubes) {}
   void destroy(const gpu::VulkanContext& context) override {
+    gpu::destroyBuffer(context, overflow_readback_);
     gpu::destroyBuffer(context, tile_lists_);
     gpu::destroyBuffer(context, tile_counts_);
     gpu::destroyComputePipeline(context, raycast_);
@@ -43,7 +44,8 @@ class TubeRaycastStage final : public FrameStage {
     const uint32_t tiles_y = (height + shader::kTubeTileSize - 1) / shader::kTubeTileSize;
     const VkDeviceSize tiles = VkDeviceSize(tiles_x) * tiles_y;
     if (!tile_counts_.buffer) {
-      tile_counts_ = gpu::createBuffer(frame.context, tiles * sizeof(uint32_t), gpu::MemoryUse::DeviceLocal);
+      // One more word: the count of overflowing tiles.
+      tile_counts_ = gpu::createBuffer(frame.context, (tiles + 1) * sizeof(uint32_t), gpu::MemoryUse::DeviceLocal);
       tile_lists_ = gpu::createBuffer(frame.context, tiles * shader::kTubeTileCapacity * sizeof(uint32_t),
                                       gpu::MemoryUse::DeviceLocal);
     }
@@ -83,6 +85,24 @@ class TubeRaycastStage final : public FrameStage {
       push.height = height;
       gpu::recordDispatch(frame.cmd, raycast_, push, tiles_x, tiles_y);
     }
+    // The overflow count to the host, read in collect().
+    if (!overflow_readback_.buffer)
+      overflow_readback_ = gpu::createBuffer(frame.context, sizeof(uint32_t), gpu::MemoryUse::Readback);
+    gpu::recordBarrier(frame.cmd, {VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, gpu::kStorageReadWrite,
+                                   VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT});
+    const VkBufferCopy region{tiles * sizeof(uint32_t), 0, sizeof(uint32_t)};
+    vkCmdCopyBuffer(frame.cmd, tile_counts_.buffer, overflow_readback_.buffer, 1, &region);
+    gpu::recordBarrier(frame.cmd, {VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                   VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT});
+    recorded_ = true;
+  }
+
+  void collect(const gpu::VulkanContext& context, FrameStats& stats) override {
+    if (!recorded_) return;
+    recorded_ = false;
+    uint32_t overflowed = 0;
+    gpu::downloadFromBuffer(context, overflow_readback_, &overflowed, sizeof(overflowed));
+    stats.tube_tiles_overflowed = overflowed;
   }
 
  private:
@@ -90,6 +110,8 @@ class TubeRaycastStage final : public FrameStage {
   gpu::ComputePipeline bin_, raycast_;  // made at the first frame with tubes
   gpu::Buffer tile_counts_;             // uint per tile
   gpu::Buffer tile_lists_;              // kTubeTileCapacity sub-segment indices per tile
+  gpu::Buffer overflow_readback_;       // the frame's count of overflowing tiles
+  bool recorded_ = false;               // a frame was recorded since the last collect
 };
 
 }  // namespace
