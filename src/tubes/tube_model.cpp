@@ -297,9 +297,21 @@ TubeModel buildTubes(const Tractogram& tractogram, const TubeBuildOptions& optio
       s.chord = chord[j];
       model.segments.push_back(s);
     }
-    if (m == 1) ++stats.single_point_tubes;
-    propagateTubeFrames(model.nodes.data() + tube.first_node, model.segments.data() + tube.first_segment, m,
-                        options.frame_substep_degrees);
+    if (m == 1) {
+      // One point: the node twice and a segment of chord 0 between them,
+      // whose sub-segments are the node's sphere (every control point the
+      // same), so the ray caster draws it as a sphere.
+      ++stats.single_point_tubes;
+      model.nodes.push_back(model.nodes.back());
+      tube.node_count = 2;
+      shader::TubeSegment s{};
+      s.node = tube.first_node;
+      s.fiber = f;
+      s.chord = 0.0f;
+      model.segments.push_back(s);
+    }
+    propagateTubeFrames(model.nodes.data() + tube.first_node, model.segments.data() + tube.first_segment,
+                        tube.node_count, options.frame_substep_degrees);
     model.tubes.push_back(tube);
   }
   stats.nodes = model.nodes.size();

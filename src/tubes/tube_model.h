@@ -65,9 +65,9 @@ struct TubeBuildOptions {
 struct TubeBuildStats {
   size_t tubes = 0;               // tubes made (fibers with at least one point)
   size_t input_points = 0;        // points of the fibers given
-  size_t nodes = 0;               // nodes made (= input_points without resampling)
+  size_t nodes = 0;               // nodes made (= input_points without resampling, + 1 per single-point tube)
   size_t invalid_radii = 0;       // NaN / infinite data values that took radius_min
-  size_t single_point_tubes = 0;  // one node, no segment (to be drawn as a sphere)
+  size_t single_point_tubes = 0;  // fibers of one distinct point: a sphere (the node twice, a segment of chord 0)
   size_t duplicate_points = 0;    // zero-length steps dropped (a segment needs a direction)
 };
 
@@ -90,8 +90,9 @@ struct TubeModel {
 // Builds one tube per fiber of `options.fibers`. Throws Error for a radius
 // <= 0 mm or not finite, radius_max < radius_min, a missing or
 // wrong-sized data array, a fiber index out of range, a tolerance < 0 or
-// NaN. Fibers of zero points are skipped; a fiber whose points all
-// coincide becomes a one-node tube. Safe on any Tractogram that passes
+// NaN. Fibers of zero points are skipped; a fiber of one point (or whose
+// points all coincide) becomes a sphere of its radius: its node twice and
+// one segment of chord 0 (TubeBuildStats::single_point_tubes). Safe on any Tractogram that passes
 // validate(); cost O(points), memory 48 bytes per node + 16 per segment.
 TubeModel buildTubes(const Tractogram& tractogram, const TubeBuildOptions& options, TubeBuildStats* stats = nullptr);
 

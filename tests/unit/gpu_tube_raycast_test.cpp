@@ -238,15 +238,41 @@ TEST_F(GpuTubeRaycast, tubesAndLinesOccludeEachOtherBothWaysAsTheReferences) {
   destroyTubes(context(), tubes);
 }
 
-TEST_F(GpuTubeRaycast, aModelWithoutSegmentsDrawsNothingAndUploadsNothing) {
-  Tractogram t;
-  const float one[] = {0, 0, 0};
-  t.addStreamline(one, 1);
-  const TubeModel model = buildTubes(t, {});
+TEST_F(GpuTubeRaycast, anEmptyModelUploadsNothing) {
+  const TubeModel model = buildTubes(Tractogram(), {});
   GpuTubes tubes = uploadTubes(context(), model);
   EXPECT_EQ(tubes.segment_count, 0u);
   EXPECT_EQ(tubes.nodes.buffer, VK_NULL_HANDLE);
   destroyTubes(context(), tubes);
+}
+
+// Issue 15 item 6: a fiber of one point is drawn, as a sphere of the radius.
+TEST_F(GpuTubeRaycast, aFiberOfOnePointIsDrawnAsASphereAsTheReference) {
+  Tractogram t;
+  const float one[] = {0, 0, 0};
+  t.addStreamline(one, 1);
+  TubeBuildOptions o;
+  o.radius.radius = 2.0f;
+  const TubeModel model = buildTubes(t, o);
+  Camera camera;
+  camera.eye = {3, 4, 30};
+  camera.width = 64;
+  camera.height = 64;
+  camera.near_mm = 20;
+  camera.far_mm = 40;
+  const TubeReferenceImage ref = renderReferenceTubes(model, camera, TubeReferenceMethod::Cascade);
+  const Agreement a = compare(castOnGpu(model, camera), ref, camera);
+  // A disk of 2 mm at 30.4 mm in a 30 degree, 64 px frame: radius 7.9 px,
+  // about 194 pixels.
+  EXPECT_NEAR(double(a.both), 194.0, 20.0) << a.summary();
+  EXPECT_GE(a.agreement(), 0.98) << a.summary();
+  EXPECT_LE(a.max_depth_mm, 2e-4) << a.summary();
+  // The reference is the sphere: its nearest point is 2 mm before the centre.
+  const double centre = std::sqrt(9.0 + 16.0 + 900.0);
+  double nearest = 1e9;
+  for (size_t i = 0; i < ref.distance.size(); ++i)
+    if (ref.fiber[i] == 0u) nearest = std::min(nearest, ref.distance[i]);
+  EXPECT_NEAR(nearest, centre - 2.0, 0.05);
 }
 
 }  // namespace

@@ -140,7 +140,7 @@ TEST(TubeModel, badRadiusOptionsAreErrorsNamingTheProblem) {
   EXPECT_THROW(buildTubes(t, o), Error);
 }
 
-TEST(TubeModel, aFiberOfOnePointIsOneNodeAndRepeatedPointsAreDropped) {
+TEST(TubeModel, aFiberOfOnePointIsASphereAndRepeatedPointsAreDropped) {
   Tractogram t;
   const float one[] = {1, 2, 3};
   t.addStreamline(one, 1);
@@ -149,12 +149,21 @@ TEST(TubeModel, aFiberOfOnePointIsOneNodeAndRepeatedPointsAreDropped) {
   TubeBuildStats stats;
   const TubeModel model = buildTubes(t, {}, &stats);
   ASSERT_EQ(model.tubes.size(), 2u);
-  EXPECT_EQ(model.tubes[0].node_count, 1u);
+  EXPECT_EQ(model.tubes[0].node_count, 2u);  // the point twice
   EXPECT_EQ(model.tubes[1].node_count, 2u);
-  EXPECT_EQ(model.segments.size(), 1u);
+  ASSERT_EQ(model.segments.size(), 2u);
+  EXPECT_EQ(model.segments[0].chord, 0.0f);
   EXPECT_EQ(stats.single_point_tubes, 1u);
   EXPECT_EQ(stats.duplicate_points, 2u);
-  EXPECT_EQ(model.nodes[2].point, 2.0f);  // the second distinct point was point 2 of the fiber
+  EXPECT_EQ(model.nodes[3].point, 2.0f);  // the second distinct point was point 2 of the fiber
+  // The one-point tube's sub-segments are its sphere: hit where a sphere of
+  // radius 0.5 at (1, 2, 3) is, by the cascade.
+  for (uint32_t half : {0u, 1u}) {
+    const TubeRayHit h = intersectTubeQuadratic(tubeSubSegment(model, half), {1.2, 2.1, 13}, {0, 0, -1});
+    ASSERT_TRUE(h.hit);
+    EXPECT_NEAR(h.distance, 10 - std::sqrt(0.25 - 0.05), 1e-6);
+  }
+  EXPECT_FALSE(intersectTubeQuadratic(tubeSubSegment(model, 0), {1.5, 2.1, 13}, {0, 0, -1}).hit);
 }
 
 // Frames on a helix of radius a and pitch 2 pi b: the rotation-minimising
