@@ -144,12 +144,16 @@ void runRender(const RenderCommandOptions& o) {
               static_cast<unsigned long long>(scene.streamlines), static_cast<unsigned long long>(scene.segments),
               o.output.c_str(), width, height, std::string(renderPipelineName(settings.pipeline)).c_str(),
               std::string(cullingModeName(settings.culling)).c_str());
-  if (o.tubes.requested())
+  if (o.tubes.requested()) {
+    double tube_ms = 0;
+    for (const PassTiming& p : stats.passes)
+      if (p.name == "tube bin" || p.name == "tube raycast") tube_ms += p.ms;
     std::printf("tubes: %llu fibers, %llu nodes (of %llu points, within %.4f mm), %u segments, radius %.3f mm, ray "
-                "cast by compute, %llu tiles overflowed\n",
+                "cast by compute in %.1f ms, %llu tiles overflowed\n",
                 static_cast<unsigned long long>(tube_stats.tubes), static_cast<unsigned long long>(tube_stats.nodes),
                 static_cast<unsigned long long>(tube_stats.input_points), o.tubes.tolerance(), tubes.segment_count,
-                o.tubes.radius_mm, static_cast<unsigned long long>(stats.tube_tiles_overflowed));
+                o.tubes.radius_mm, tube_ms, static_cast<unsigned long long>(stats.tube_tiles_overflowed));
+  }
   if (filter.active())
     std::printf("filter: %llu of %llu fibers kept (%s), %.2f ms on the GPU\n",
                 static_cast<unsigned long long>(filter.kept()), static_cast<unsigned long long>(filter.fibers()),
