@@ -106,15 +106,29 @@ void runRender(const RenderCommandOptions& o) {
   scene_options.upload_raw = settings.pipeline != RenderPipeline::Compute;
   LoadedScene scene = loadScene(waitForDevice, scene_options);
   const gpu::VulkanContext& context = waitForDevice();
+  // With --tubes-dim-rest the tube fibers are the selection (the other
+  // lines dimmed by --dim-unselected), unless the filter's dimming selects
+  // already.
+  gpu::Buffer tube_selection;
   struct TubesOwner {
     const gpu::VulkanContext& context;
     GpuTubes& tubes;
-    ~TubesOwner() { destroyTubes(context, tubes); }
-  } tubes_owner{context, tubes};
+    gpu::Buffer& selection;
+    ~TubesOwner() {
+      gpu::destroyBuffer(context, selection);
+      destroyTubes(context, tubes);
+    }
+  } tubes_owner{context, tubes, tube_selection};
   TubeBuildStats tube_stats;
-  if (o.tubes.requested()) {
+  std::vector<uint32_t> tube_words;
+  if (o.tubes.requested() && o.tubes.dim_rest && !o.render.dim_dropped) {
     const TubeModel model = loadTubeModel(o.render.input, o.render.phantom_streamlines, o.tubes, &tube_stats);
     tubes = uploadTubes(context, model);
+    tube_words.assign((scene.streamlines + 31) / 32, 0u);
+    for (const TubeModel::Tube& t : model.tubes)
+      if (t.fiber / 32 < tube_words.size()) tube_words[t.fiber / 32] |= 1u << (t.fiber % 32);
+  } else if (o.tubes.requested()) {
+    tubes = uploadTubes(context, loadTubeModel(o.render.input, o.render.phantom_streamlines, o.tubes, &tube_stats));
   }
 
   GpuScene gpu_scene = scene.gpuScene();
@@ -123,6 +137,11 @@ void runRender(const RenderCommandOptions& o) {
   filter.apply(gpu_scene, settings.pipeline);
   if (settings.color == ColorMode::Scalar && !o.render.gave("scalar-range"))
     filter.distanceRange(settings.scalar_min, settings.scalar_max);  // colour by distance: its range
+  if (!tube_words.empty() && gpu_scene.selection_bits == 0) {
+    tube_selection = gpu::createBuffer(context, tube_words.size() * sizeof(uint32_t), gpu::MemoryUse::DeviceLocal);
+    gpu::uploadToBuffer(context, tube_selection, tube_words.data(), tube_words.size() * sizeof(uint32_t));
+    gpu_scene.selection_bits = tube_selection.address;
+  }
   const SceneCuts cuts(context, o.render);
   cuts.apply(gpu_scene);
   GpuAnatomy anatomy;

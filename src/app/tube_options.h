@@ -18,6 +18,7 @@ struct TubeCliOptions {
   std::string fibers;  // "" none, "all", or indices and ranges: "0-99,512"
   float radius_mm = 0.5f;
   float resample_tolerance_mm = -1.0f;  // < 0: a twentieth of the radius
+  bool dim_rest = false;                // the tube fibers as the selection: highlighted, the rest dimmed
   float tolerance() const { return resample_tolerance_mm < 0.0f ? radius_mm / 20.0f : resample_tolerance_mm; }
   bool requested() const { return !fibers.empty(); }
 };

@@ -50,6 +50,16 @@ TEST_F(GpuCliTubes, renderDrawsTheListedFibersAsTubesOverTheLines) {
   // Eleven tubes 3 mm wide at ~0.7 px/mm, partly behind the lines (189
   // pixels changed at radius 0.8 mm).
   EXPECT_GT(changed, 250u) << changed;
+  // --tubes-dim-rest makes them the selection: every other line dims too.
+  const std::string dimmed = dir_.file("dimmed.png");
+  const auto c = runFibscope(common + dimmed + " --tubes 0-9,50 --tube-radius 1.5 --tubes-dim-rest");
+  ASSERT_EQ(c.exit_code, 0) << c.output;
+  const test::Png pc = test::readOurPng(dimmed);
+  ASSERT_EQ(pc.rgba.size(), pa.rgba.size());
+  size_t changed_dimmed = 0;
+  for (size_t i = 0; i < pa.rgba.size(); i += 4)
+    changed_dimmed += pa.rgba[i] != pc.rgba[i] || pa.rgba[i + 1] != pc.rgba[i + 1] || pa.rgba[i + 2] != pc.rgba[i + 2];
+  EXPECT_GT(changed_dimmed, 3 * changed);
 }
 
 TEST_F(GpuCliTubes, badTubeOptionsAreOneLineErrors) {
