@@ -81,8 +81,10 @@ void main() {
       const vec4 c = cameraTransformPoint(cam.view_projection, o + s * d);
       if (!(c.w > 0.0)) continue;
       const float depth = c.z / c.w;
-      // Ties: the smaller item (the CPU reference's order).
-      if (depth >= 0.0 && depth <= 1.0 && (depth < best_depth || (depth == best_depth && s_items[j] < best_item))) {
+      // Strictly nearer than what other surfaces left; ties between tube
+      // items: the smaller item (the CPU reference's order).
+      if (depth >= 0.0 && depth <= 1.0 &&
+          (depth < best_depth || (best_item != 0xFFFFFFFFu && depth == best_depth && s_items[j] < best_item))) {
         best_depth = depth;
         best_item = s_items[j];
         best_t = t;
@@ -102,7 +104,10 @@ void main() {
   texel.depth = best_depth;
   texel.fiber = s.fiber;
   texel.normal = packSegmentTangent(hit - tubeQuadraticCenter(q, best_t));
-  texel.tangent = packSegmentTangent(tubeQuadraticDerivative(q, best_t));
+  // The centre line's direction; a one-point tube (a sphere, no
+  // direction) takes its normal, as sphere_surface.comp does.
+  const vec3 dq = tubeQuadraticDerivative(q, best_t);
+  texel.tangent = dot(dq, dq) > 0.0 ? packSegmentTangent(dq) : texel.normal;
   texel.position = mix(a.point, b.point, u);
   texel.color = 0u;
   if (a.color >> 24 != 0u || b.color >> 24 != 0u) {

@@ -107,7 +107,7 @@ void runRender(const RenderCommandOptions& o) {
   LoadedScene scene = loadScene(waitForDevice, scene_options);
   const gpu::VulkanContext& context = waitForDevice();
   // With --tubes-dim-rest the tube fibers are the selection (the other
-  // lines dimmed by --dim-unselected), unless the filter's dimming selects
+  // lines dimmed by --dim), unless the filter's dimming selects
   // already.
   gpu::Buffer tube_selection;
   struct TubesOwner {

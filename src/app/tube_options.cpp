@@ -16,7 +16,7 @@ void addTubeCliOptions(CLI::App* cmd, TubeCliOptions& o) {
                   "Draw these fibers as ray-cast spline tubes over the lines: all, or indices and ranges (0-99,512)");
   cmd->add_option("--tube-radius", o.radius_mm, "Tube radius in mm (default 0.5)");
   cmd->add_flag("--tubes-dim-rest", o.dim_rest,
-               "Make the tube fibers the selection: their lines highlighted, the others dimmed (--dim-unselected)");
+               "Make the tube fibers the selection: their lines highlighted, the others dimmed (--dim)");
   cmd->add_option("--tube-tolerance", o.resample_tolerance_mm,
                   "Resample the tubes' centre lines within this distance of the fibers in mm (default: radius / 20; 0 keeps "
                   "every point)");

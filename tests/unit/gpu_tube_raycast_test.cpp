@@ -261,7 +261,11 @@ TEST_F(GpuTubeRaycast, aFiberOfOnePointIsDrawnAsASphereAsTheReference) {
   camera.near_mm = 20;
   camera.far_mm = 40;
   const TubeReferenceImage ref = renderReferenceTubes(model, camera, TubeReferenceMethod::Cascade);
-  const Agreement a = compare(castOnGpu(model, camera), ref, camera);
+  const std::vector<shader::SurfaceTexel> surface = castOnGpu(model, camera);
+  const Agreement a = compare(surface, ref, camera);
+  // No centre line direction: the tangent (orientation colour) is the normal.
+  for (const shader::SurfaceTexel& t : surface)
+    if (t.depth < 1.0f) ASSERT_EQ(t.tangent, t.normal);
   // A disk of 2 mm at 30.4 mm in a 30 degree, 64 px frame: radius 7.9 px,
   // about 194 pixels.
   EXPECT_NEAR(double(a.both), 194.0, 20.0) << a.summary();
