@@ -13,7 +13,8 @@ namespace fibscope {
 
 void addTubeCliOptions(CLI::App* cmd, TubeCliOptions& o) {
   cmd->add_option("--tubes", o.fibers,
-                  "Draw these fibers as ray-cast spline tubes over the lines: all, or indices and ranges (0-99,512)");
+                  "Draw these fibers as ray-cast spline tubes over the lines: all, or indices and ranges (0-99,512)")
+      ->each([&o](const std::string&) { o.given = true; });
   cmd->add_option("--tube-radius", o.radius_mm, "Tube radius in mm (default 0.5)");
   cmd->add_flag("--tubes-dim-rest", o.dim_rest,
                "Make the tube fibers the selection: their lines highlighted, the others dimmed (--dim)");
@@ -105,6 +106,17 @@ TubeModel loadTubeModel(const std::string& path, uint64_t phantom_streamlines, c
       throw Error((path.empty() ? std::string("phantom") : path) + ": fiber " + std::to_string(sorted[next]) +
                   " was not found (the input ended after " + std::to_string(first) + " streamlines)");
   }
+  float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (size_t i = 0; i < selected.pointCount(); ++i)
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], selected.point(i)[k]);
+      hi[k] = std::max(hi[k], selected.point(i)[k]);
+    }
+  const float extent = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                                 (hi[2] - lo[2]) * (hi[2] - lo[2]));
+  if (selected.pointCount() > 1 && options.radius_mm > extent)
+    throw Error("--tube-radius: " + std::to_string(options.radius_mm) + " mm is larger than the selected fibers' extent (" +
+                std::to_string(extent) + " mm across)");
   TubeBuildOptions build;
   build.radius.radius = options.radius_mm;
   build.resample_tolerance = options.tolerance();

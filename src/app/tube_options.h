@@ -19,8 +19,9 @@ struct TubeCliOptions {
   float radius_mm = 0.5f;
   float resample_tolerance_mm = -1.0f;  // < 0: a twentieth of the radius
   bool dim_rest = false;                // the tube fibers as the selection: highlighted, the rest dimmed
+  bool given = false;                   // --tubes was on the command line (even as an empty string)
   float tolerance() const { return resample_tolerance_mm < 0.0f ? radius_mm / 20.0f : resample_tolerance_mm; }
-  bool requested() const { return !fibers.empty(); }
+  bool requested() const { return given || !fibers.empty(); }
 };
 
 void addTubeCliOptions(CLI::App* cmd, TubeCliOptions& options);
@@ -34,7 +35,9 @@ std::vector<uint32_t> parseFiberSelection(const std::string& text, uint64_t coun
 // The tube model of the selected fibers of the input (a file, or the
 // built-in phantom of `phantom_streamlines` when `path` is empty), read in
 // chunks (only the selected fibers are kept in memory); fiber ids are the
-// input's streamline indices. Throws Error naming the input or the option.
+// input's streamline indices. Throws Error naming the input or the option,
+// also for a radius larger than the selected fibers' extent (the bounding
+// box's diagonal): such tubes would only hide the scene.
 TubeModel loadTubeModel(const std::string& path, uint64_t phantom_streamlines, const TubeCliOptions& options,
                         TubeBuildStats* stats = nullptr);
 

@@ -69,7 +69,9 @@ TEST_F(GpuCliTubes, badTubeOptionsAreOneLineErrors) {
            {" --tubes 0-3 --tube-radius 0", "--tube-radius"},
            {" --tubes 0-3 --tube-radius nan", "--tube-radius"},
            {" --tubes 50", "out of range"},
-           {" --tubes seven", "--tubes"}}) {
+           {" --tubes seven", "--tubes"},
+           {" --tubes ''", "empty"},
+           {" --tubes 0-3 --tube-radius 5000", "larger than the selected fibers' extent"}}) {
     const auto r = runFibscope(common + args);
     EXPECT_EQ(r.exit_code, 2) << args << ": " << r.output;
     EXPECT_NE(r.output.find(want), std::string::npos) << args << ": " << r.output;
