@@ -58,7 +58,8 @@ void BM_BuildTubes(benchmark::State& state) {
   state.counters["points"] = double(t.pointCount());
   state.counters["nodes"] = double(nodes);
   state.counters["buffer_MB"] = double(bytes) / 1e6;
-  state.counters["points_per_s"] = benchmark::Counter(double(t.pointCount()), benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["points_per_s"] =
+      benchmark::Counter(double(t.pointCount()), benchmark::Counter::kIsIterationInvariantRate);
 }
 // Tolerance in micrometres: 0 keeps every point.
 BENCHMARK(BM_BuildTubes)->Arg(0)->Arg(10)->Unit(benchmark::kMillisecond)->Iterations(1);

@@ -17,10 +17,11 @@ void addTubeCliOptions(CLI::App* cmd, TubeCliOptions& o) {
       ->each([&o](const std::string&) { o.given = true; });
   cmd->add_option("--tube-radius", o.radius_mm, "Tube radius in mm (default 0.5)");
   cmd->add_flag("--tubes-dim-rest", o.dim_rest,
-               "Make the tube fibers the selection: their lines highlighted, the others dimmed (--dim)");
-  cmd->add_option("--tube-tolerance", o.resample_tolerance_mm,
-                  "Resample the tubes' centre lines within this distance of the fibers in mm (default: radius / 20; 0 keeps "
-                  "every point)");
+                "Make the tube fibers the selection: their lines highlighted, the others dimmed (--dim)");
+  cmd->add_option(
+      "--tube-tolerance", o.resample_tolerance_mm,
+      "Resample the tubes' centre lines within this distance of the fibers in mm (default: radius / 20; 0 keeps "
+      "every point)");
 }
 
 std::vector<uint32_t> parseFiberSelection(const std::string& text, uint64_t count) {
@@ -115,8 +116,8 @@ TubeModel loadTubeModel(const std::string& path, uint64_t phantom_streamlines, c
   const float extent = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                                  (hi[2] - lo[2]) * (hi[2] - lo[2]));
   if (selected.pointCount() > 1 && options.radius_mm > extent)
-    throw Error("--tube-radius: " + std::to_string(options.radius_mm) + " mm is larger than the selected fibers' extent (" +
-                std::to_string(extent) + " mm across)");
+    throw Error("--tube-radius: " + std::to_string(options.radius_mm) +
+                " mm is larger than the selected fibers' extent (" + std::to_string(extent) + " mm across)");
   TubeBuildOptions build;
   build.radius.radius = options.radius_mm;
   build.resample_tolerance = options.tolerance();

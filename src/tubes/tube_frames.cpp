@@ -35,8 +35,8 @@ glm::vec3 doubleReflection(const glm::vec3& x0, const glm::vec3& t0, const glm::
 glm::vec3 anyNormal(const glm::vec3& t) {
   // Cross with the axis least aligned with t: never near-parallel.
   const glm::vec3 a = std::fabs(t.x) <= std::fabs(t.y) && std::fabs(t.x) <= std::fabs(t.z) ? glm::vec3(1, 0, 0)
-                      : std::fabs(t.y) <= std::fabs(t.z)                                  ? glm::vec3(0, 1, 0)
-                                                                                          : glm::vec3(0, 0, 1);
+                      : std::fabs(t.y) <= std::fabs(t.z)                                   ? glm::vec3(0, 1, 0)
+                                                                                           : glm::vec3(0, 0, 1);
   return glm::normalize(glm::cross(t, a));
 }
 

@@ -153,8 +153,8 @@ TubeRayHit intersectTubeQuadratic(const shader::TubeQuadratic& q, const glm::dve
   return best;
 }
 
-TubeRayHit intersectTubeQuadraticBruteForce(const shader::TubeQuadratic& q, const glm::dvec3& o,
-                                            const glm::dvec3& d, uint32_t samples) {
+TubeRayHit intersectTubeQuadraticBruteForce(const shader::TubeQuadratic& q, const glm::dvec3& o, const glm::dvec3& d,
+                                            uint32_t samples) {
   // Front distance of the sphere at t, +inf where the ray misses it.
   const auto front = [&](double t) {
     const glm::dvec3 oc = o - tubeQuadraticCenter(q, t);

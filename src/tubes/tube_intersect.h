@@ -53,8 +53,8 @@ TubeRayHit intersectTubeQuadratic(const shader::TubeQuadratic& q, const glm::dve
 // Independent reference: the exact front root of each of `samples`
 // spheres S(t_k) evenly spaced in t, the nearest refined by golden-section
 // search of f over its neighbourhood. Slow; for tests.
-TubeRayHit intersectTubeQuadraticBruteForce(const shader::TubeQuadratic& q, const glm::dvec3& o,
-                                            const glm::dvec3& d, uint32_t samples = 4096);
+TubeRayHit intersectTubeQuadraticBruteForce(const shader::TubeQuadratic& q, const glm::dvec3& o, const glm::dvec3& d,
+                                            uint32_t samples = 4096);
 
 // The quadratic's centre and radius at t (Bezier).
 glm::dvec3 tubeQuadraticCenter(const shader::TubeQuadratic& q, double t);
@@ -68,10 +68,10 @@ shader::TubeQuadratic tubeSubSegment(const TubeModel& model, uint32_t index);
 // through the pixel centre against every sub-segment.
 struct TubeReferenceImage {
   uint32_t width = 0, height = 0;
-  std::vector<float> depth;        // clip depth z/w; 1 where nothing is hit
-  std::vector<double> distance;    // along the eye ray (mm); 0 where nothing is hit
-  std::vector<uint32_t> fiber;     // kNoFiberId where nothing is hit
-  std::vector<float> position;     // along the fiber in points (TubeNode::point interpolated)
+  std::vector<float> depth;      // clip depth z/w; 1 where nothing is hit
+  std::vector<double> distance;  // along the eye ray (mm); 0 where nothing is hit
+  std::vector<uint32_t> fiber;   // kNoFiberId where nothing is hit
+  std::vector<float> position;   // along the fiber in points (TubeNode::point interpolated)
   std::vector<glm::vec3> normal;
   size_t covered() const;
 };

@@ -33,7 +33,8 @@ void checkOptions(const TubeBuildOptions& o) {
   const TubeRadius& r = o.radius;
   const auto positive = [](float v) { return std::isfinite(v) && v > 0.0f; };
   if (r.source == TubeRadius::Source::Constant) {
-    if (!positive(r.radius)) throw Error("tubes: the radius must be a finite number > 0 mm, got " + std::to_string(r.radius));
+    if (!positive(r.radius))
+      throw Error("tubes: the radius must be a finite number > 0 mm, got " + std::to_string(r.radius));
   } else {
     if (!positive(r.radius_min) || !positive(r.radius_max) || r.radius_max < r.radius_min)
       throw Error("tubes: the radius range must be finite, > 0 mm and ordered, got [" + std::to_string(r.radius_min) +
@@ -57,7 +58,9 @@ float mapRadius(const TubeRadius& r, float v, size_t& invalid) {
 }
 
 uint32_t packColor(const glm::vec3& c) {
-  const auto byte = [](float v) { return uint32_t(std::lround(std::clamp(std::isfinite(v) ? v : 0.0f, 0.0f, 1.0f) * 255.0f)); };
+  const auto byte = [](float v) {
+    return uint32_t(std::lround(std::clamp(std::isfinite(v) ? v : 0.0f, 0.0f, 1.0f) * 255.0f));
+  };
   return byte(c.x) | byte(c.y) << 8 | byte(c.z) << 16 | 0xFFu << 24;
 }
 
@@ -187,7 +190,9 @@ uint32_t packUnitVector(const glm::vec3& t) {
       y = (1.0f - std::fabs(ox)) * (y >= 0.0f ? 1.0f : -1.0f);
     }
   }
-  const auto snorm = [](float v) { return uint32_t(uint16_t(int16_t(std::lround(std::clamp(v, -1.0f, 1.0f) * 32767.0f)))); };
+  const auto snorm = [](float v) {
+    return uint32_t(uint16_t(int16_t(std::lround(std::clamp(v, -1.0f, 1.0f) * 32767.0f))));
+  };
   return snorm(x) | snorm(y) << 16;
 }
 
@@ -284,8 +289,8 @@ TubeModel buildTubes(const Tractogram& tractogram, const TubeBuildOptions& optio
       node.position_radius = {p.x, p.y, p.z, radius[j]};
       node.tangent_dradius = {t.x, t.y, t.z, dr};
       node.color = options.color.source == TubeColor::Source::Constant ? options.color.rgba
-                   : color_array                                        ? packColor(color[j])
-                                                                        : 0u;
+                   : color_array                                       ? packColor(color[j])
+                                                                       : 0u;
       node.color_slope = color_array ? packSlope(dc) : 0u;
       node.point = float(distinct[kept[j]]);
       model.nodes.push_back(node);

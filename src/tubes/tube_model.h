@@ -33,8 +33,8 @@ namespace fibscope {
 struct TubeRadius {
   enum class Source { Constant, PerFiber, PerPoint };
   Source source = Source::Constant;
-  float radius = 0.5f;     // mm (Constant)
-  std::string array;       // per_streamline (PerFiber) or per_point (PerPoint) array, 1 component
+  float radius = 0.5f;  // mm (Constant)
+  std::string array;    // per_streamline (PerFiber) or per_point (PerPoint) array, 1 component
   float data_min = 0.0f, data_max = 1.0f;
   float radius_min = 0.2f, radius_max = 1.0f;  // mm
 };

@@ -89,7 +89,8 @@ Agreement compare(const std::vector<shader::SurfaceTexel>& gpu, const TubeRefere
     const double z_ref = ref.distance[i] * glm::dot(d, forward);
     a.max_depth_mm = std::max(a.max_depth_mm, std::fabs(z_gpu - z_ref));
     const std::array<float, 3> g = test::unpackTangent(gpu[i].normal);
-    a.max_normal_error = std::max(a.max_normal_error, double(glm::distance(glm::vec3(g[0], g[1], g[2]), ref.normal[i])));
+    a.max_normal_error =
+        std::max(a.max_normal_error, double(glm::distance(glm::vec3(g[0], g[1], g[2]), ref.normal[i])));
     a.max_position_error = std::max(a.max_position_error, double(std::fabs(gpu[i].position - ref.position[i])));
   }
   return a;
@@ -104,8 +105,8 @@ TEST_F(GpuTubeRaycast, computeRayCastingMatchesTheCpuReferenceOnCurvedTubes) {
       const Agreement a = compare(castOnGpu(model, camera, &stats), ref, camera);
       EXPECT_EQ(stats.tube_tiles_overflowed, 0u);
       const std::string what = scene.name + " from (" + std::to_string(camera.eye[0]) + ", " +
-                               std::to_string(camera.eye[1]) + ", " + std::to_string(camera.eye[2]) + "): " +
-                               a.summary();
+                               std::to_string(camera.eye[1]) + ", " + std::to_string(camera.eye[2]) +
+                               "): " + a.summary();
       EXPECT_GT(a.both, 250u) << what;
       EXPECT_GE(a.agreement(), 0.98) << what;
       EXPECT_EQ(a.fiber_mismatch, 0u) << what;
@@ -123,7 +124,7 @@ TEST_F(GpuTubeRaycast, tilesWhoseListsOverflowStillDrawEveryTube) {
   for (int i = 0; i < 300; ++i) {
     const float a = float(i) * 0.02f, z = float(i) * 0.008f;
     const float xyz[] = {-2.0f * std::cos(a), -2.0f * std::sin(a), z, 0.0f, 0.3f * std::sin(3.0f * a), z,
-                         2.0f * std::cos(a), 2.0f * std::sin(a), z};
+                         2.0f * std::cos(a),  2.0f * std::sin(a),  z};
     t.addStreamline(xyz, 3);
   }
   TubeBuildOptions o;

@@ -24,7 +24,9 @@ namespace {
 glm::vec3 nodePosition(const shader::TubeNode& n) {
   return {n.position_radius.x, n.position_radius.y, n.position_radius.z};
 }
-glm::vec3 nodeTangent(const shader::TubeNode& n) { return {n.tangent_dradius.x, n.tangent_dradius.y, n.tangent_dradius.z}; }
+glm::vec3 nodeTangent(const shader::TubeNode& n) {
+  return {n.tangent_dradius.x, n.tangent_dradius.y, n.tangent_dradius.z};
+}
 
 // A random walk of `n` steps of `step` mm turning at most `max_turn_deg`
 // per step (tracker-like).
@@ -81,8 +83,8 @@ TEST(TubeModel, quadraticSubSegmentsJoinAtTheCubicsMidpointAndFollowTheNodeTange
   for (uint32_t k = 0; k < model.segments.size(); ++k) {
     const shader::TubeSegment& s = model.segments[k];
     const shader::TubeQuadratic q0 = tubeSubSegment(model, 2 * k), q1 = tubeSubSegment(model, 2 * k + 1);
-    const glm::dvec3 p0 = tubeQuadraticCenter(q0, 0), mid0 = tubeQuadraticCenter(q0, 1), mid1 = tubeQuadraticCenter(q1, 0),
-                     p1 = tubeQuadraticCenter(q1, 1);
+    const glm::dvec3 p0 = tubeQuadraticCenter(q0, 0), mid0 = tubeQuadraticCenter(q0, 1),
+                     mid1 = tubeQuadraticCenter(q1, 0), p1 = tubeQuadraticCenter(q1, 1);
     EXPECT_LT(glm::distance(glm::vec3(p0), nodePosition(model.nodes[s.node])), 1e-5f);
     EXPECT_LT(glm::distance(glm::vec3(p1), nodePosition(model.nodes[s.node + 1])), 1e-5f);
     EXPECT_LT(glm::distance(mid0, mid1), 1e-6);
@@ -210,7 +212,7 @@ TEST(TubeFrames, subStepsFollowTheDenseRotationMinimisingFrameAcrossATightTurn) 
   std::vector<float> xyz;
   glm::vec3 p(0.0f);
   for (const glm::vec3& d : {glm::vec3(1, 0, 0), glm::vec3(1, 0, 0), glm::vec3(0, 1, 0.3f), glm::vec3(-1, 0.2f, 0.5f),
-                            glm::vec3(0, -1, 0.6f), glm::vec3(1, 0, 0.4f), glm::vec3(1, 0, 0)}) {
+                             glm::vec3(0, -1, 0.6f), glm::vec3(1, 0, 0.4f), glm::vec3(1, 0, 0)}) {
     xyz.insert(xyz.end(), {p.x, p.y, p.z});
     p += glm::normalize(d);
   }
@@ -223,16 +225,18 @@ TEST(TubeFrames, subStepsFollowTheDenseRotationMinimisingFrameAcrossATightTurn) 
   glm::dvec3 r = glm::dvec3(unpackUnitVector(with.nodes[0].normal));
   double worst_with = 0, worst_without = 0, max_turn = 0;
   for (const shader::TubeSegment& s : with.segments) {
-    max_turn = std::max(max_turn, std::acos(std::clamp(double(glm::dot(nodeTangent(with.nodes[s.node]),
-                                                                       nodeTangent(with.nodes[s.node + 1]))),
-                                                       -1.0, 1.0)));
+    max_turn = std::max(
+        max_turn,
+        std::acos(std::clamp(double(glm::dot(nodeTangent(with.nodes[s.node]), nodeTangent(with.nodes[s.node + 1]))),
+                             -1.0, 1.0)));
     constexpr int kSteps = 20000;
     for (int k = 1; k <= kSteps; ++k) {
       const glm::dvec3 d = glm::normalize(glm::dvec3(tubeSegmentDerivative(with, s, float(k) / kSteps)));
       r = glm::normalize(r - glm::dot(r, d) * d);
     }
     const auto angle = [&](uint32_t packed) {
-      return std::acos(std::clamp(glm::dot(r, glm::dvec3(unpackUnitVector(packed))), -1.0, 1.0)) * 180 / std::numbers::pi;
+      return std::acos(std::clamp(glm::dot(r, glm::dvec3(unpackUnitVector(packed))), -1.0, 1.0)) * 180 /
+             std::numbers::pi;
     };
     worst_with = std::max(worst_with, angle(with.nodes[s.node + 1].normal));
     worst_without = std::max(worst_without, angle(without.nodes[s.node + 1].normal));

@@ -9,7 +9,8 @@ namespace fibscope {
 
 GpuTubes uploadTubes(const gpu::VulkanContext& context, const TubeModel& model) {
   if (model.segments.size() >= (size_t(1) << 31))
-    throw Error("tubes: " + std::to_string(model.segments.size()) + " segments is more than the 2^31 - 1 one frame draws");
+    throw Error("tubes: " + std::to_string(model.segments.size()) +
+                " segments is more than the 2^31 - 1 one frame draws");
   GpuTubes tubes;
   if (model.segments.empty()) return tubes;
   try {
