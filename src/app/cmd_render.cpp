@@ -119,24 +119,26 @@ void runRender(const RenderCommandOptions& o) {
       destroyTubes(context, tubes);
     }
   } tubes_owner{context, tubes, tube_selection};
-  TubeBuildStats tube_stats;
-  std::vector<uint32_t> tube_words;
-  if (o.tubes.requested() && o.tubes.dim_rest && !o.render.dim_dropped) {
-    const TubeModel model = loadTubeModel(o.render.input, o.render.phantom_streamlines, o.tubes, &tube_stats);
-    tubes = uploadTubes(context, model);
-    tube_words.assign((scene.streamlines + 31) / 32, 0u);
-    for (const TubeModel::Tube& t : model.tubes)
-      if (t.fiber / 32 < tube_words.size()) tube_words[t.fiber / 32] |= 1u << (t.fiber % 32);
-  } else if (o.tubes.requested()) {
-    tubes = uploadTubes(context, loadTubeModel(o.render.input, o.render.phantom_streamlines, o.tubes, &tube_stats));
-  }
-
   GpuScene gpu_scene = scene.gpuScene();
   applyScalarColoring(context, scene.fiblets, o.render, settings, gpu_scene);
   const SceneFilter filter(context, scene, criteria, o.render.dim_dropped);
   filter.apply(gpu_scene, settings.pipeline);
   if (settings.color == ColorMode::Scalar && !o.render.gave("scalar-range"))
     filter.distanceRange(settings.scalar_min, settings.scalar_max);  // colour by distance: its range
+  TubeBuildStats tube_stats;
+  std::vector<uint32_t> tube_words;
+  if (o.tubes.requested()) {
+    std::vector<uint32_t> kept;
+    if (filter.active()) kept = filter.keptFibers();
+    const TubeModel model = loadTubeModel(o.render.input, o.render.phantom_streamlines, o.tubes, &tube_stats,
+                                          filter.active() ? &kept : nullptr);
+    tubes = uploadTubes(context, model);
+    if (o.tubes.dim_rest && !o.render.dim_dropped) {
+      tube_words.assign((scene.streamlines + 31) / 32, 0u);
+      for (const TubeModel::Tube& t : model.tubes)
+        if (t.fiber / 32 < tube_words.size()) tube_words[t.fiber / 32] |= 1u << (t.fiber % 32);
+    }
+  }
   if (!tube_words.empty() && gpu_scene.selection_bits == 0) {
     tube_selection = gpu::createBuffer(context, tube_words.size() * sizeof(uint32_t), gpu::MemoryUse::DeviceLocal);
     gpu::uploadToBuffer(context, tube_selection, tube_words.data(), tube_words.size() * sizeof(uint32_t));

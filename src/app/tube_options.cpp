@@ -12,8 +12,10 @@
 namespace fibscope {
 
 void addTubeCliOptions(CLI::App* cmd, TubeCliOptions& o) {
-  cmd->add_option("--tubes", o.fibers,
-                  "Draw these fibers as ray-cast spline tubes over the lines: all, or indices and ranges (0-99,512)")
+  cmd->add_option(
+         "--tubes", o.fibers,
+         "Draw these fibers as ray-cast spline tubes over the lines: all, filtered (the filter's kept fibers), or "
+         "indices and ranges (0-99,512)")
       ->each([&o](const std::string&) { o.given = true; });
   cmd->add_option("--tube-radius", o.radius_mm, "Tube radius in mm (default 0.5)");
   cmd->add_flag("--tubes-dim-rest", o.dim_rest,
@@ -64,7 +66,7 @@ std::vector<uint32_t> parseFiberSelection(const std::string& text, uint64_t coun
 }
 
 TubeModel loadTubeModel(const std::string& path, uint64_t phantom_streamlines, const TubeCliOptions& options,
-                        TubeBuildStats* stats) {
+                        TubeBuildStats* stats, const std::vector<uint32_t>* filtered) {
   if (!(options.radius_mm > 0.0f) || !std::isfinite(options.radius_mm))
     throw Error("--tube-radius: expected a radius > 0 mm, got " + std::to_string(options.radius_mm));
   if (!(options.tolerance() >= 0.0f) || !std::isfinite(options.tolerance()))
@@ -84,8 +86,18 @@ TubeModel loadTubeModel(const std::string& path, uint64_t phantom_streamlines, c
       while (reader->read(chunk)) count += chunk.streamlineCount();
     }
   }
-  const std::vector<uint32_t> wanted = parseFiberSelection(options.fibers, count);
-  if (wanted.empty()) throw Error("--tubes: no fibers selected");
+  std::vector<uint32_t> wanted;
+  if (options.fibers == "filtered") {
+    if (!filtered) throw Error("--tubes filtered: give the fiber filter's criteria (--include, --exclude, ...)");
+    wanted = *filtered;
+    for (uint32_t f : wanted)
+      if (f >= count) throw Error("--tubes filtered: fiber " + std::to_string(f) + " is out of range");
+  } else {
+    wanted = parseFiberSelection(options.fibers, count);
+  }
+  if (wanted.empty())
+    throw Error(options.fibers == "filtered" ? "--tubes filtered: the filter kept no fibers"
+                                             : "--tubes: no fibers selected");
   std::vector<uint32_t> sorted = wanted;
   std::sort(sorted.begin(), sorted.end());
   // The selected streamlines, in index order.

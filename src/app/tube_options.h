@@ -15,7 +15,7 @@
 namespace fibscope {
 
 struct TubeCliOptions {
-  std::string fibers;  // "" none, "all", or indices and ranges: "0-99,512"
+  std::string fibers;  // "" none, "all", "filtered" (the fiber filter's kept ones), or indices and ranges: "0-99,512"
   float radius_mm = 0.5f;
   float resample_tolerance_mm = -1.0f;  // < 0: a twentieth of the radius
   bool dim_rest = false;                // the tube fibers as the selection: highlighted, the rest dimmed
@@ -38,7 +38,9 @@ std::vector<uint32_t> parseFiberSelection(const std::string& text, uint64_t coun
 // input's streamline indices. Throws Error naming the input or the option,
 // also for a radius larger than the selected fibers' extent (the bounding
 // box's diagonal): such tubes would only hide the scene.
+// `filtered`: the fibers of --tubes filtered (the filter's kept indices),
+// used when options.fibers is "filtered".
 TubeModel loadTubeModel(const std::string& path, uint64_t phantom_streamlines, const TubeCliOptions& options,
-                        TubeBuildStats* stats = nullptr);
+                        TubeBuildStats* stats = nullptr, const std::vector<uint32_t>* filtered = nullptr);
 
 }  // namespace fibscope

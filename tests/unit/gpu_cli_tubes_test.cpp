@@ -5,6 +5,7 @@
 // device.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <string>
 
 #include "app/tube_options.h"
@@ -60,6 +61,28 @@ TEST_F(GpuCliTubes, renderDrawsTheListedFibersAsTubesOverTheLines) {
   for (size_t i = 0; i < pa.rgba.size(); i += 4)
     changed_dimmed += pa.rgba[i] != pc.rgba[i] || pa.rgba[i + 1] != pc.rgba[i + 1] || pa.rgba[i + 2] != pc.rgba[i + 2];
   EXPECT_GT(changed_dimmed, 3 * changed);
+}
+
+TEST_F(GpuCliTubes, filteredTubesAreTheFibersTheFilterKeeps) {
+  const auto r = runFibscope(
+      "render --validate --phantom-streamlines 300 --size 96x72 --include sphere:0,0,20,15 "
+      "--tubes filtered --tube-radius 0.3 -o " +
+      dir_.file("f.png"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  unsigned long long tubes = 0, kept = 0, total = 0;
+  const size_t t = r.output.find("tubes: "), f = r.output.find("filter: ");
+  ASSERT_NE(t, std::string::npos) << r.output;
+  ASSERT_NE(f, std::string::npos) << r.output;
+  ASSERT_EQ(std::sscanf(r.output.c_str() + t, "tubes: %llu fibers", &tubes), 1) << r.output;
+  ASSERT_EQ(std::sscanf(r.output.c_str() + f, "filter: %llu of %llu", &kept, &total), 2) << r.output;
+  EXPECT_EQ(tubes, kept);
+  EXPECT_GT(kept, 0u);
+  EXPECT_LT(kept, total);
+  // Without criteria there is nothing to take.
+  const auto none =
+      runFibscope("render --phantom-streamlines 50 --size 64x48 --tubes filtered -o " + dir_.file("n.png"));
+  EXPECT_EQ(none.exit_code, 2);
+  EXPECT_NE(none.output.find("--tubes filtered"), std::string::npos) << none.output;
 }
 
 TEST_F(GpuCliTubes, badTubeOptionsAreOneLineErrors) {
