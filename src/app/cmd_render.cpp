@@ -17,16 +17,20 @@
 #include "app/render_scene.h"
 #include "app/scene_cuts.h"
 #include "app/scene_filter.h"
+#include "app/tube_options.h"
 #include "core/error.h"
 #include "io/png_writer.h"
 #include "render/camera.h"
 #include "render/gpu/frame_renderer.h"
+#include "render/gpu/frame_stages.h"
+#include "tubes/gpu/gpu_tubes.h"
 
 namespace fibscope {
 namespace {
 
 struct RenderCommandOptions {
   RenderCliOptions render;
+  TubeCliOptions tubes;
   std::string view;
   std::string camera;
   std::string output;
@@ -75,14 +79,19 @@ void runRender(const RenderCommandOptions& o) {
   // compiles every shader with LLVM here) take ~0.15 s on one core: made on
   // a second thread during the first pass over the file, which reads on
   // one core. loadScene waits for them only when it uploads.
+  // The tubes' buffers: the tube stage reads them at every frame (filled
+  // below, released by `tubes_owner` before the device goes).
+  GpuTubes tubes;
   struct Device {
     std::unique_ptr<gpu::VulkanContext> context;
     std::unique_ptr<FrameRenderer> renderer;  // destroyed before the context
   };
-  std::future<Device> making = std::async(std::launch::async, [&o, &settings, width, height] {
+  std::future<Device> making = std::async(std::launch::async, [&o, &settings, &tubes, width, height] {
     Device d;
     d.context = createRenderContext(o.render);
-    d.renderer = std::make_unique<FrameRenderer>(*d.context, width, height);
+    d.renderer = std::make_unique<FrameRenderer>(
+        *d.context, width, height,
+        o.tubes.requested() ? withTubeStage(standardFrameStages(), &tubes) : standardFrameStages());
     d.renderer->prepare(settings);  // this frame's shader variants
     return d;
   });
@@ -98,13 +107,44 @@ void runRender(const RenderCommandOptions& o) {
   scene_options.fiber_scalars = criteria.scalar_ranges;
   LoadedScene scene = loadScene(waitForDevice, scene_options);
   const gpu::VulkanContext& context = waitForDevice();
-
+  // With --tubes-dim-rest the tube fibers are the selection (the other
+  // lines dimmed by --dim), unless the filter's dimming selects
+  // already.
+  gpu::Buffer tube_selection;
+  struct TubesOwner {
+    const gpu::VulkanContext& context;
+    GpuTubes& tubes;
+    gpu::Buffer& selection;
+    ~TubesOwner() {
+      gpu::destroyBuffer(context, selection);
+      destroyTubes(context, tubes);
+    }
+  } tubes_owner{context, tubes, tube_selection};
   GpuScene gpu_scene = scene.gpuScene();
   applyScalarColoring(context, scene.fiblets, o.render, settings, gpu_scene);
   const SceneFilter filter(context, scene, criteria, o.render.dim_dropped);
   filter.apply(gpu_scene, settings.pipeline);
   if (settings.color == ColorMode::Scalar && !o.render.gave("scalar-range"))
     filter.distanceRange(settings.scalar_min, settings.scalar_max);  // colour by distance: its range
+  TubeBuildStats tube_stats;
+  std::vector<uint32_t> tube_words;
+  if (o.tubes.requested()) {
+    std::vector<uint32_t> kept;
+    if (filter.active()) kept = filter.keptFibers();
+    const TubeModel model = loadTubeModel(o.render.input, o.render.phantom_streamlines, o.tubes, &tube_stats,
+                                          filter.active() ? &kept : nullptr);
+    tubes = uploadTubes(context, model);
+    if (o.tubes.dim_rest && !o.render.dim_dropped) {
+      tube_words.assign((scene.streamlines + 31) / 32, 0u);
+      for (const TubeModel::Tube& t : model.tubes)
+        if (t.fiber / 32 < tube_words.size()) tube_words[t.fiber / 32] |= 1u << (t.fiber % 32);
+    }
+  }
+  if (!tube_words.empty() && gpu_scene.selection_bits == 0) {
+    tube_selection = gpu::createBuffer(context, tube_words.size() * sizeof(uint32_t), gpu::MemoryUse::DeviceLocal);
+    gpu::uploadToBuffer(context, tube_selection, tube_words.data(), tube_words.size() * sizeof(uint32_t));
+    gpu_scene.selection_bits = tube_selection.address;
+  }
   const SceneCuts cuts(context, o.render);
   cuts.apply(gpu_scene);
   GpuAnatomy anatomy;
@@ -126,6 +166,16 @@ void runRender(const RenderCommandOptions& o) {
               static_cast<unsigned long long>(scene.streamlines), static_cast<unsigned long long>(scene.segments),
               o.output.c_str(), width, height, std::string(renderPipelineName(settings.pipeline)).c_str(),
               std::string(cullingModeName(settings.culling)).c_str());
+  if (o.tubes.requested()) {
+    double tube_ms = 0;
+    for (const PassTiming& p : stats.passes)
+      if (p.name == "tube bin" || p.name == "tube raycast") tube_ms += p.ms;
+    std::printf("tubes: %llu fibers, %llu nodes (of %llu points, within %.4f mm), %u segments, radius %.3f mm, ray "
+                "cast by compute in %.1f ms, %llu tiles overflowed\n",
+                static_cast<unsigned long long>(tube_stats.tubes), static_cast<unsigned long long>(tube_stats.nodes),
+                static_cast<unsigned long long>(tube_stats.input_points), o.tubes.tolerance(), tubes.segment_count,
+                o.tubes.radius_mm, tube_ms, static_cast<unsigned long long>(stats.tube_tiles_overflowed));
+  }
   if (filter.active())
     std::printf("filter: %llu of %llu fibers kept (%s), %.2f ms on the GPU\n",
                 static_cast<unsigned long long>(filter.kept()), static_cast<unsigned long long>(filter.fibers()),
@@ -148,6 +198,7 @@ void addRenderCommand(CLI::App& app) {
   // So that nobody mistakes left for right (--no-orientation-labels).
   o->render.defaults.orientation_labels = true;
   addRenderCliOptions(cmd, o->render);
+  addTubeCliOptions(cmd, o->tubes);
   cmd->add_option("--view", o->view, "sagittal | coronal | axial");
   cmd->add_option("--camera", o->camera, "AZ,EL,DIST: orbit angles in degrees and distance factor (0: framed snugly, 1: the bounding sphere fits)");
   cmd->add_option("-o,--output", o->output, "Output PNG")->required();

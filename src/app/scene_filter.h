@@ -35,6 +35,8 @@ class SceneFilter {
   // the colormap's range); false without one.
   bool distanceRange(float& lo, float& hi) const;
   uint64_t kept() const { return fiblets_ ? fiblets_->keptCount() : 0; }
+  // The kept fibers' indices, ascending (downloaded); empty when inactive.
+  std::vector<uint32_t> keptFibers() const;
   uint64_t fibers() const { return fiblets_ ? fiblets_->fiberCount() : 0; }
   double gpuMilliseconds() const { return gpu_ms_; }
 

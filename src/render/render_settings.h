@@ -176,6 +176,9 @@ struct FrameStats {
   uint64_t fiblets_lod = 0;        // ... drawn as one segment (far-view LoD)
   uint64_t segments_total = 0;     // segments in the dataset (every pipeline)
   uint64_t covered_pixels = 0;     // pixels with a fiber after the frame (when counted)
+  // Spline tubes' compute ray casting (src/tubes/gpu): screen tiles whose
+  // sub-segment list overflowed, each of which tested every sub-segment.
+  uint64_t tube_tiles_overflowed = 0;
 };
 
 }  // namespace fibscope

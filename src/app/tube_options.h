@@ -1,0 +1,46 @@
+// Spline tubes on the command line (issue 15 item 5, the part that exists:
+// compute ray casting): `--tubes FIBERS|all` with `--tube-radius MM` draws
+// the listed fibers as ray-cast tubes over the lines, depth-composited.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/tractogram.h"
+#include "tubes/tube_model.h"
+
+namespace fibscope {
+
+struct TubeCliOptions {
+  std::string fibers;  // "" none, "all", "filtered" (the fiber filter's kept ones), or indices and ranges: "0-99,512"
+  float radius_mm = 0.5f;
+  float resample_tolerance_mm = -1.0f;  // < 0: a twentieth of the radius
+  bool dim_rest = false;                // the tube fibers as the selection: highlighted, the rest dimmed
+  bool given = false;                   // --tubes was on the command line (even as an empty string)
+  float tolerance() const { return resample_tolerance_mm < 0.0f ? radius_mm / 20.0f : resample_tolerance_mm; }
+  bool requested() const { return given || !fibers.empty(); }
+};
+
+void addTubeCliOptions(CLI::App* cmd, TubeCliOptions& options);
+
+// "all" -> every index below `count`; "A-B,C,..." -> those indices, in the
+// order given, repeats dropped. Throws Error (one line, naming --tubes) for
+// malformed text, a reversed range or an index >= count. Safe on untrusted
+// text.
+std::vector<uint32_t> parseFiberSelection(const std::string& text, uint64_t count);
+
+// The tube model of the selected fibers of the input (a file, or the
+// built-in phantom of `phantom_streamlines` when `path` is empty), read in
+// chunks (only the selected fibers are kept in memory); fiber ids are the
+// input's streamline indices. Throws Error naming the input or the option,
+// also for a radius larger than the selected fibers' extent (the bounding
+// box's diagonal): such tubes would only hide the scene.
+// `filtered`: the fibers of --tubes filtered (the filter's kept indices),
+// used when options.fibers is "filtered".
+TubeModel loadTubeModel(const std::string& path, uint64_t phantom_streamlines, const TubeCliOptions& options,
+                        TubeBuildStats* stats = nullptr, const std::vector<uint32_t>* filtered = nullptr);
+
+}  // namespace fibscope

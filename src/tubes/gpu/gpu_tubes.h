@@ -1,0 +1,38 @@
+// The tubes buffer on the device (shared/tubes.h: node and segment
+// records of a TubeModel) and the compute ray caster's frame stage.
+#pragma once
+
+#include <cstdint>
+
+#include "gpu/buffer.h"
+#include "gpu/vulkan_context.h"
+#include "render/gpu/frame_stage.h"
+#include "tubes/tube_model.h"
+
+namespace fibscope {
+
+struct GpuTubes {
+  gpu::Buffer nodes;     // TubeNode per node
+  gpu::Buffer segments;  // TubeSegment per segment
+  uint32_t node_count = 0;
+  uint32_t segment_count = 0;
+  uint32_t subSegmentCount() const { return 2 * segment_count; }
+};
+
+// Uploads the model's records (device-local). A model without segments
+// gives empty buffers (nothing to draw). Throws Error when memory runs out
+// or the model holds 2^31 segments or more (sub-segment indices are 32-bit).
+GpuTubes uploadTubes(const gpu::VulkanContext& context, const TubeModel& model);
+void destroyTubes(const gpu::VulkanContext& context, GpuTubes& tubes);
+
+// Surfaces: "tube bin" and "tube raycast", the compute ray casting of
+// `tubes` into the surface target (tube_bin.comp, tube_raycast.comp); runs
+// in frames where `tubes` is not null and has segments. `tubes` is read at
+// every frame and must outlive the renderer.
+FrameStageFactory tubeRaycastStage(const GpuTubes* tubes);
+
+// `stages` with the tube stage inserted before the surface merge (at the
+// end when the list has none).
+FrameStageList withTubeStage(FrameStageList stages, const GpuTubes* tubes);
+
+}  // namespace fibscope
