@@ -14,6 +14,8 @@
 
 layout(local_size_x_id = WORKGROUP_SIZE_X_ID, local_size_y_id = WORKGROUP_SIZE_Y_ID) in;  // kPixelGroupSize
 
+layout(constant_id = kPostSpecSharpen) const bool kSharpen = false;
+
 layout(push_constant, std430) uniform Push { PostPush pc; };
 
 layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer ColorIn { uint values[]; };
@@ -47,8 +49,7 @@ void main() {
   const ivec2 p = ivec2(gl_GlobalInvocationID.xy);
   if (p.x >= int(pc.width) || p.y >= int(pc.height)) return;
   vec3 c = grade(fetch(p));
-  // The factor is the same for every pixel: a uniform branch.
-  if (pc.sharpen != 0.0) {
+  if (kSharpen) {
     // y grows downwards (top row first).
     const vec3 around = grade(fetch(p + ivec2(0, -1))) + grade(fetch(p + ivec2(0, 1))) +
                         grade(fetch(p + ivec2(-1, 0))) + grade(fetch(p + ivec2(1, 0)));

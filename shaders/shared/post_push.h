@@ -34,6 +34,10 @@ POST_CONST float kPostLumaR = 0.2125f;
 POST_CONST float kPostLumaG = 0.7154f;
 POST_CONST float kPostLumaB = 0.0721f;
 
+// Whether step 5 runs (constant_id; 1 when sharpen != 0): the variant
+// without it reads one pixel instead of five.
+POST_CONST uint kPostSpecSharpen = 0u;
+
 struct PostPush {
   uint64_t color_in;   // uint per pixel (RGBA8, R in the low byte)
   uint64_t color_out;  // uint per pixel (written; a different buffer)

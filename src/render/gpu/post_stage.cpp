@@ -57,12 +57,24 @@ ShadeTarget postOutput(const RenderSettings& s) {
 }
 
 PostPass createPostPass(const gpu::VulkanContext& context) {
-  return {gpu::createComputePipeline(context, "post_effects.comp", sizeof(shader::PostPush),
-                                     gpu::WorkgroupSize{shader::kPixelGroupSize, shader::kPixelGroupSize})};
+  PostPass pass;
+  try {
+    for (uint32_t sharpen : {0u, 1u}) {
+      const uint32_t specialization[] = {sharpen};  // kPostSpecSharpen
+      pass.pipelines[sharpen] =
+          gpu::createComputePipeline(context, "post_effects.comp", sizeof(shader::PostPush),
+                                     gpu::WorkgroupSize{shader::kPixelGroupSize, shader::kPixelGroupSize},
+                                     specialization);
+    }
+  } catch (...) {
+    destroyPostPass(context, pass);
+    throw;
+  }
+  return pass;
 }
 
 void destroyPostPass(const gpu::VulkanContext& context, PostPass& pass) {
-  gpu::destroyComputePipeline(context, pass.pipeline);
+  for (gpu::ComputePipeline& p : pass.pipelines) gpu::destroyComputePipeline(context, p);
 }
 
 void recordPostEffects(VkCommandBuffer cmd, const PostPass& pass, const gpu::Buffer& input,
@@ -77,7 +89,7 @@ void recordPostEffects(VkCommandBuffer cmd, const PostPass& pass, const gpu::Buf
   push.brightness = s.brightness;
   push.saturation = s.saturation;
   push.sharpen = s.sharpen;
-  gpu::recordDispatch(cmd, pass.pipeline, push, shader::pixelGroups(width), shader::pixelGroups(height));
+  gpu::recordDispatch(cmd, pass.pipelines[s.sharpen != 0.0f ? 1 : 0], push, shader::pixelGroups(width), shader::pixelGroups(height));
 }
 
 std::unique_ptr<FrameStage> makePostStage(const gpu::VulkanContext& context) {

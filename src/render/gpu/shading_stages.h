@@ -66,7 +66,8 @@ void recordFxaa(VkCommandBuffer cmd, const FxaaPass& pass, const gpu::Buffer& in
 // that size) with the settings' flatten, contrast, brightness, saturation
 // and sharpen: the post stage's pass, exposed for tests on hand-made images.
 struct PostPass {
-  gpu::ComputePipeline pipeline;  // post_effects.comp
+  // post_effects.comp without and with sharpening (kPostSpecSharpen).
+  std::array<gpu::ComputePipeline, 2> pipelines;
 };
 PostPass createPostPass(const gpu::VulkanContext& context);
 void destroyPostPass(const gpu::VulkanContext& context, PostPass& pass);
