@@ -105,6 +105,14 @@ struct RenderSettings {
   // FXAA (Lottes' fast approximate anti-aliasing, 3.11 quality-like) over
   // the shaded RGBA8 image: smooths the stair steps of 1-pixel lines.
   bool fxaa = false;
+  // Post effects (FiberVisualizer section 12) over the shaded image, after
+  // ambient occlusion and before FXAA, in this order; each is off at its
+  // default (neutral) value. Formulas: shaders/shared/post_push.h.
+  int flatten_levels = 0;     // colour flattening to n levels a channel (2 to 256; 0 or 1: off)
+  float contrast = 1.0f;      // (c - 0.5) k + 0.5
+  float brightness = 0.0f;    // c + d
+  float saturation = 1.0f;    // L + s (c - L), L the Rec. 709 luminance (0: grey)
+  float sharpen = 0.0f;       // 3 x 3 sharpening kernel's factor
   std::array<float, 3> background = {0.0f, 0.0f, 0.0f};
   // Cuts (DESIGN.md section 2): fibers are clipped per pixel, not dropped,
   // and a segment crossing a plane is drawn up to the plane

@@ -160,6 +160,21 @@ std::vector<SettingInfo> makeTable() {
                           "Neighbours nearer than this (view distance) no longer occlude, in mm",
                           &RenderSettings::ssao_range_mm, 0.5, 200, "mm"),
                    hasSsao));
+  // Post effects, in the order they apply (after AO, before FXAA).
+  SettingInfo flatten = entry("flatten", "flatten",
+                              "Colour flattening to N levels a channel (2 to 256; 0 or 1: off)", SettingKind::Integer);
+  flatten.integer = &RenderSettings::flatten_levels;
+  flatten.min = 0;
+  flatten.max = 256;
+  t.push_back(flatten);
+  t.push_back(number("contrast", "contrast", "Contrast: (c - 0.5) C + 0.5 (1: off)", &RenderSettings::contrast, 0, 4));
+  t.push_back(number("brightness", "brightness", "Brightness: c + D (0: off)", &RenderSettings::brightness, -1, 1));
+  t.push_back(number("saturation", "saturation",
+                     "Saturation: L + S (c - L), L = 0.2125 R + 0.7154 G + 0.0721 B (0: grey, 1: off)",
+                     &RenderSettings::saturation, 0, 4));
+  t.push_back(number("sharpen", "sharpen",
+                     "Sharpening by the 3x3 kernel [0 -S 0; -S 1+4S -S; 0 -S 0] (0: off)", &RenderSettings::sharpen,
+                     0, 4));
   t.push_back(flag("fxaa", "FXAA", "Fast approximate anti-aliasing of the image", &RenderSettings::fxaa));
   t.push_back(color("background", "background", "Background colour R,G,B in [0, 1]", &RenderSettings::background));
   t.push_back(number("slab", "slab",

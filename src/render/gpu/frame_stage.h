@@ -11,7 +11,7 @@
 //   geometry      one of compute / raw-compute / lines: the lines' G-buffer
 //   surfaces      any number: nearer-wins writes into the surface target
 //   merge         surface pixels nearer than the lines into the G-buffer
-//   shading       tiles, SSAO, shade, FXAA: the G-buffer -> RGBA8
+//   shading       tiles, SSAO, shade, post effects, FXAA: the G-buffer -> RGBA8
 #pragma once
 
 #include <vulkan/vulkan.h>

@@ -2,7 +2,7 @@
 
 namespace fibscope {
 
-FrameStageList shadingStages() { return {makeTilesStage, makeSsaoStage, makeShadeStage, makeFxaaStage}; }
+FrameStageList shadingStages() { return {makeTilesStage, makeSsaoStage, makeShadeStage, makePostStage, makeFxaaStage}; }
 
 FrameStageList standardFrameStages() {
   FrameStageList list = {

@@ -33,12 +33,14 @@ std::unique_ptr<FrameStage> makeSurfaceMergeStage(const gpu::VulkanContext& cont
 std::unique_ptr<FrameStage> makeTilesStage(const gpu::VulkanContext& context);
 std::unique_ptr<FrameStage> makeSsaoStage(const gpu::VulkanContext& context);
 std::unique_ptr<FrameStage> makeShadeStage(const gpu::VulkanContext& context);
+// "post": post effects after shading (and AO), before FXAA (post_stage.cpp).
+std::unique_ptr<FrameStage> makePostStage(const gpu::VulkanContext& context);
 std::unique_ptr<FrameStage> makeFxaaStage(const gpu::VulkanContext& context);
 // "orientation": the orientation labels and axis triad over the final
 // image (orientation_overlay.comp), after FXAA.
 std::unique_ptr<FrameStage> makeOrientationStage(const gpu::VulkanContext& context);
 
-// tiles, ssao, shade, fxaa: the G-buffer (and surface target) -> RGBA8.
+// tiles, ssao, shade, post, fxaa: the G-buffer (and surface target) -> RGBA8.
 FrameStageList shadingStages();
 // Everything a frame of any pipeline needs, in order: setup, the three
 // geometry stages, the surface stages, merge, shading, the orientation

@@ -1,6 +1,7 @@
 // Shading, last and optional: FXAA (fxaa.comp, Lottes' FXAA 3.11 quality
-// preset as shared/shade_push.h describes) of the shaded image into the
-// frame's colour.
+// preset as shared/shade_push.h describes) of the shaded (and, when they
+// run, post-processed) image, always read from `shaded`, into the frame's
+// colour (shading_stages.h: ShadeTarget).
 #include "gpu/pass_scope.h"
 #include "render/gpu/frame_stages.h"
 #include "render/gpu/shading_stages.h"

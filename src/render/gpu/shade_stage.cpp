@@ -91,7 +91,7 @@ class ShadeStage final : public FrameStage {
     push.gbuffer = t.gbuffer.address;
     push.surface = frame.surfaces ? t.surface.address : 0;
     push.ao = ssaoRuns(s) ? t.ao.address : 0;
-    push.color = (fxaaRuns(s) ? t.shaded : t.color).address;
+    push.color = (shadeTarget(s) == ShadeTarget::Shaded ? t.shaded : t.color).address;
     push.tiles = t.tile_list.address;
     push.block = block_.address;
     push.width = t.width;

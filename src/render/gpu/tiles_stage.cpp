@@ -39,7 +39,7 @@ class TilesStage final : public FrameStage {
 
   void record(FrameContext& frame) override {
     const GpuFrameTargets& t = frame.targets;
-    const gpu::Buffer& output = fxaaRuns(frame.settings) ? t.shaded : t.color;
+    const gpu::Buffer& output = shadeTarget(frame.settings) == ShadeTarget::Shaded ? t.shaded : t.color;
     // The list and the filled image before the tile passes and their
     // indirect reads of the list's header.
     gpu::PassScope pass(frame.cmd, frame.timer, "tiles", gpu::kComputeToIndirect);
