@@ -34,7 +34,7 @@ TckStreamlineScan::TckStreamlineScan(TrackDataStream& data, uint64_t data_begin,
   data_.restart(begin > data_begin ? begin - kTriplet : begin, stop);
 }
 
-size_t TckStreamlineScan::findSeparator() {
+size_t TckStreamlineScan::findSeparator(bool keep) {
   size_t scanned = 0;  // samples at the front known finite, whole triplets
   while (true) {
     const size_t available = data_.available() / 4;
@@ -46,7 +46,7 @@ size_t TckStreamlineScan::findSeparator() {
     if (data_.available() >= data_.capacity() / 2) {
       // The streamline fills the buffer: move what there is of it aside.
       const float* front = reinterpret_cast<const float*>(data_.data());
-      long_.insert(long_.end(), front, front + whole);
+      if (keep) long_.insert(long_.end(), front, front + whole);
       data_.consume(4 * whole);
       scanned = 0;
     } else {
@@ -58,8 +58,7 @@ size_t TckStreamlineScan::findSeparator() {
 
 TckStreamlineScan::Step TckStreamlineScan::skipToStart() {
   data_.fill(kTriplet);
-  const size_t hit = findSeparator();
-  long_.clear();  // what spilled belongs to the range before
+  const size_t hit = findSeparator(/*keep=*/false);  // what it passes belongs to the range before
   if (hit == kNone || hit % 3 != 0) return Step::Damaged;
   const uint8_t* triplet = data_.data() + 4 * hit;
   const auto kind = tripletKind(triplet);
@@ -86,7 +85,7 @@ TckStreamlineScan::Step TckStreamlineScan::next() {
   }
   long_.clear();
   data_.fill(kTriplet);
-  const size_t hit = findSeparator();
+  const size_t hit = findSeparator(/*keep=*/true);
   if (hit == kNone || hit % 3 != 0) {
     done_ = true;
     return Step::Damaged;

@@ -51,9 +51,10 @@ class TckStreamlineScan {
   // Skips to the first streamline start at or after the range's beginning.
   Step skipToStart();
   // Finds the first non-finite triplet at the front, growing the buffer's
-  // window (or spilling into long_) until it is there; its sample index
-  // from the front, or npos at the end of the data.
-  size_t findSeparator();
+  // window until it is there (a streamline that outgrows the buffer goes
+  // to long_ when `keep`, else is dropped: a skip); its sample index from
+  // the front, or npos at the end of the data.
+  size_t findSeparator(bool keep);
 
   TrackDataStream& data_;
   uint64_t stop_;

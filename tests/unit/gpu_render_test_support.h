@@ -14,6 +14,7 @@
 #include "phantom/phantom.h"
 #include "shared/gbuffer.h"
 #include "shared/render_config.h"
+#include "tubes/tube_model.h"
 
 namespace fibscope::test {
 
@@ -53,18 +54,11 @@ inline std::vector<uint8_t> gbufferMask(const std::vector<shader::GBufferTexel>&
   return mask;
 }
 
-// glsl/tangent.glsl's unpackTangent: snorm16 x 2, octahedral, normalised.
+// glsl/tangent.glsl's unpackTangent (tubes/tube_model.h's unpackUnitVector,
+// the one C++ decoding of the packed G-buffer vectors).
 inline std::array<float, 3> unpackTangent(uint32_t packed) {
-  const auto snorm = [](uint32_t bits) { return std::clamp(float(int16_t(uint16_t(bits))) / 32767.0f, -1.0f, 1.0f); };
-  float x = snorm(packed & 0xFFFFu), y = snorm(packed >> 16);
-  const float z = 1.0f - std::fabs(x) - std::fabs(y);
-  if (z < 0.0f) {
-    const float ox = x;
-    x = (1.0f - std::fabs(y)) * (ox >= 0.0f ? 1.0f : -1.0f);
-    y = (1.0f - std::fabs(ox)) * (y >= 0.0f ? 1.0f : -1.0f);
-  }
-  const float l = std::sqrt(x * x + y * y + z * z);
-  return {x / l, y / l, z / l};
+  const glm::vec3 v = unpackUnitVector(packed);
+  return {v.x, v.y, v.z};
 }
 
 }  // namespace fibscope::test
