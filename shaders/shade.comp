@@ -2,10 +2,11 @@
 // base colour (solid, |tangent| as RGB, a hashed per-fiber colour, a
 // per-fiber scalar through a colormap, the view-facing normal, or the
 // highlight colour of a selected fiber) times
-// the lighting (none, or illuminated lines: Zoeckler, Stalling, Hege 1996,
+// the lighting (none; illuminated lines: Zoeckler, Stalling, Hege 1996,
 // which light a line from its tangent alone: the normal is the one in the
 // plane of T and L that maximises the Phong terms; surfaces: Blinn-Phong
-// from their normal), times the ambient
+// from their normal; or PBR: Cook-Torrance under FiberVisualizer's ring of
+// directional lights, lines taking their view-facing normal), times the ambient
 // occlusion factor when ssao.comp ran, unselected fibers faded towards the
 // background when there is a selection, as RGBA8 (R in the low byte,
 // A = 255). Empty pixels get the background colour. Formulas:
@@ -61,11 +62,47 @@ vec3 viewNormalColor(CameraBlock cam, vec3 n) {
   return 0.5 + 0.5 * vec3(dot(n, cameraRight(cam)), dot(n, cameraUp(cam)), dot(n, cameraBack(cam)));
 }
 
-// The line's normal facing the eye, in view space, as a colour.
-vec3 normalColor(CameraBlock cam, vec3 t, vec3 v) {
+
+// Light i of the PBR ring in world space (shared/shade_push.h).
+vec3 ringLightDirection(CameraBlock cam, uint i) {
+  const float azimuth = 6.28318531 * float(i) / float(kPbrLights);
+  const float s = sin(kPbrRingPolar);
+  return s * cos(azimuth) * cameraRight(cam) + s * sin(azimuth) * cameraUp(cam) + cos(kPbrRingPolar) * cameraBack(cam);
+}
+
+// Cook-Torrance (GGX, Schlick-GGX/Smith, Fresnel-Schlick) summed over the
+// ring, plus the ambient term (formulas: shared/shade_push.h).
+vec3 pbrColor(ShadeBlockRef block, CameraBlock cam, vec3 albedo, vec3 n, vec3 v) {
+  const float rough = block.b.roughness, metal = block.b.metalness;
+  const float a = rough * rough, a2 = a * a;
+  const float k = (rough + 1.0) * (rough + 1.0) / 8.0;
+  const vec3 f0 = mix(vec3(0.04), albedo, metal);
+  const float nv = max(dot(n, v), 0.0);
+  const float g1v = nv / (nv * (1.0 - k) + k);
+  const float radiance = block.b.light_intensity / float(kPbrLights);
+  vec3 sum = vec3(0.0);
+  for (uint i = 0u; i < kPbrLights; ++i) {
+    const vec3 l = ringLightDirection(cam, i);
+    const float nl = dot(n, l);
+    if (nl <= 0.0) continue;
+    const vec3 h = normalize(l + v);
+    const float nh = max(dot(n, h), 0.0), hv = max(dot(h, v), 0.0);
+    const float q = nh * nh * (a2 - 1.0) + 1.0;
+    const float d = a2 / (3.14159265 * q * q);
+    const float g = g1v * nl / (nl * (1.0 - k) + k);
+    const vec3 f = f0 + (1.0 - f0) * pow(1.0 - hv, 5.0);
+    const vec3 kd = (1.0 - f) * (1.0 - metal);
+    const vec3 specular = d * g * f / max(4.0 * nl * nv, kPbrMinDenominator);
+    sum += (kd * albedo / 3.14159265 + specular) * radiance * nl;
+  }
+  return block.b.ambient * albedo + sum;
+}
+
+// The line's unit normal facing the eye: in the plane of T and V.
+vec3 viewFacingNormal(vec3 t, vec3 v) {
   const vec3 towards = v - dot(v, t) * t;
   const float len = length(towards);
-  return viewNormalColor(cam, len > kShadeNormalParallelEps ? towards / len : v);
+  return len > kShadeNormalParallelEps ? towards / len : v;
 }
 
 // The headlight in world space.
@@ -116,7 +153,7 @@ void main() {
     else if (COLOR_MODE == kShadeColorPerFiber) c = fiberColor(texel.fiber);
     else if (COLOR_MODE == kShadeColorScalar)
       c = known ? scalarColor(block, ScalarRef(block.b.fiber_scalars).values[texel.fiber]) : abs(t);
-    else if (COLOR_MODE == kShadeColorNormal) c = surface ? viewNormalColor(cam, n) : normalColor(cam, t, v);
+    else if (COLOR_MODE == kShadeColorNormal) c = viewNormalColor(cam, surface ? n : viewFacingNormal(t, v));
     else c = unpackRgb8(block.b.solid);
     if (LIGHTING == kShadeLightingIlluminated) {
       const vec3 l = lightDirection(cam);
@@ -133,6 +170,8 @@ void main() {
         const float specular = pow(cos_rv, shininess);
         c = c * (ambient + diffuse_k * diffuse) + vec3(specular_k * specular);
       }
+    } else if (LIGHTING == kShadeLightingPbr) {
+      c = pbrColor(block, cam, c, surface ? n : viewFacingNormal(t, v), v);
     }
     if (pc.ao != 0ul) c *= AoRef(pc.ao).values[index];
     if (dimmed) c = mix(c, background, block.b.dim_unselected);

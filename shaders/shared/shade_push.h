@@ -36,6 +36,22 @@ SHADE_CONST float kShadeNormalParallelEps = 1e-3f;
 // The lighting (RenderSettings::lighting): shade.comp's kShadeSpecLighting.
 SHADE_CONST uint kShadeLightingNone = 0u;
 SHADE_CONST uint kShadeLightingIlluminated = 1u;
+SHADE_CONST uint kShadeLightingPbr = 2u;
+
+// Physically based lighting (FiberVisualizer section 10.3): a fixed set of
+// kPbrLights directional lights of equal radiance, a ring around the view
+// axis (light i at polar angle kPbrRingPolar from the direction towards the
+// eye, azimuth 2 pi i / kPbrLights from the camera's right axis), in view
+// space like the headlight, so the model is lit alike from whichever side
+// it is seen: a ring light, every surface facing the eye lit from all
+// round, silhouettes from one side only. The paper places its 30 lights
+// around the model; the polar angle is ours (45 degrees: the highlights of
+// a tube sit between its axis and its rim).
+SHADE_CONST uint kPbrLights = 30u;
+SHADE_CONST float kPbrRingPolar = 0.78539816f;  // pi / 4
+// Cook-Torrance's denominator 4 (N.L)(N.V) is kept above this, so grazing
+// pixels do not divide by zero.
+SHADE_CONST float kPbrMinDenominator = 1e-4f;
 
 // Neighbours sampled per pixel by ssao.comp (a Vogel spiral, turned by one
 // of kSsaoRotations angles chosen by the pixel's place in a 4 x 4 tile:
@@ -139,6 +155,18 @@ struct SsaoBlurPush {
 // slices (kShadeSpecTranslucentSlices), a pixel whose surface texel is a
 // slice nearer than its G-buffer texel (which the merge kept) ends as
 // mix(its colour, the slice's grey, the slice's alpha).
+// PBR (kShadeLightingPbr; Cook-Torrance, Karis 2013's real-time terms) with
+// N the surface normal or, for lines, the view-facing normal in the plane
+// of T and V (N = normalize(V - (V.T) T); V when the line is seen end-on),
+// albedo the base colour, rho = roughness, m = metalness, for each of the
+// kPbrLights directions L with H = normalize(L + V):
+//   D = a^2 / (pi ((N.H)^2 (a^2 - 1) + 1)^2),  a = rho^2          (GGX)
+//   G = G1(N.V) G1(N.L), G1(x) = x / (x (1 - k) + k), k = (rho + 1)^2 / 8
+//                                                  (Schlick-GGX, Smith)
+//   F = F0 + (1 - F0) (1 - H.V)^5, F0 = mix(0.04, albedo, m)  (Schlick)
+//   colour += (kd albedo / pi + D G F / max(4 (N.L)(N.V), kPbrMinDenominator))
+//             * (light_intensity / kPbrLights) * N.L          for N.L > 0,
+//   kd = (1 - F)(1 - m); and colour starts at ambient * albedo.
 // Base colours: Scalar reads fiber_scalars[fiber] and the colormap table
 // (entry round(255 t), t = (s - scalar_min) / (scalar_max - scalar_min)
 // clamped, NaN -> 0, max == min -> 0.5); a fiber id >= fiber_count falls
@@ -180,7 +208,11 @@ struct ShadeBlock {
   uint highlight;  // RGBA8
   float dim_unselected;
   uint fiber_count;  // fibers the scalars and selection bits cover
+  float roughness;   // PBR, in [0.05, 1] (the settings table's range: 0 would make D a spike)
+  float metalness;   // PBR, in [0, 1]
+  float light_intensity;  // PBR: the ring's total radiance (each light's is 1 / kPbrLights of it)
   uint pad0;
+  uint pad1;
   uint colormap[kShadeColormapEntries];  // RGBA8: the chosen colormap's table
 };
 
@@ -222,8 +254,9 @@ static_assert(sizeof(fibscope::shader::SsaoBlurPush) == 64, "");
 static_assert(sizeof(fibscope::shader::ShadePush) == 64, "");
 static_assert(offsetof(fibscope::shader::ShadePush, width) == 56, "scalars follow the seven addresses");
 static_assert(offsetof(fibscope::shader::ShadeBlock, solid) == 16, "");
-static_assert(offsetof(fibscope::shader::ShadeBlock, colormap) == 64, "");
-static_assert(sizeof(fibscope::shader::ShadeBlock) == 64 + 4 * fibscope::shader::kShadeColormapEntries, "");
+static_assert(offsetof(fibscope::shader::ShadeBlock, roughness) == 60, "");
+static_assert(offsetof(fibscope::shader::ShadeBlock, colormap) == 80, "");
+static_assert(sizeof(fibscope::shader::ShadeBlock) == 80 + 4 * fibscope::shader::kShadeColormapEntries, "");
 static_assert(sizeof(fibscope::shader::FxaaPush) == 40, "");
 #endif
 

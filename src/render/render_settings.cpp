@@ -32,7 +32,7 @@ constexpr std::pair<std::string_view, ColorMode> kColors[] = {
     {"solid", ColorMode::Solid}, {"orientation", ColorMode::Orientation}, {"fiber", ColorMode::PerFiber},
     {"scalar", ColorMode::Scalar}, {"normal", ColorMode::Normal}};
 constexpr std::pair<std::string_view, Lighting> kLighting[] = {
-    {"none", Lighting::None}, {"illuminated", Lighting::IlluminatedLines}};
+    {"none", Lighting::None}, {"illuminated", Lighting::IlluminatedLines}, {"pbr", Lighting::Pbr}};
 constexpr std::pair<std::string_view, Colormap> kColormaps[] = {{"viridis", Colormap::Viridis},
                                                                 {"magma", Colormap::Magma},
                                                                 {"grayscale", Colormap::Grayscale},

@@ -62,6 +62,7 @@ enum class SliceSampling : uint8_t { Trilinear, Nearest };
 enum class Lighting : uint8_t {
   None,
   IlluminatedLines,  // Zoeckler / Stalling / Hege: diffuse and specular from the tangent alone
+  Pbr,               // FiberVisualizer 10.3: Cook-Torrance (GGX) under a ring of 30 directional lights
 };
 
 struct RenderSettings {
@@ -90,6 +91,13 @@ struct RenderSettings {
   float light_diffuse = 0.8f;
   float light_specular = 0.5f;
   float light_shininess = 48.0f;
+  // PBR: colour = ambient * albedo + the Cook-Torrance sum over the ring of
+  // lights of total radiance pbr_intensity (shaders/shared/shade_push.h).
+  // pi makes a white diffuse surface facing the eye come out at
+  // cos(45 degrees) of its albedo, about as bright as illuminated lines.
+  float pbr_roughness = 0.5f;
+  float pbr_metalness = 0.0f;
+  float pbr_intensity = 3.14159265f;
   bool ssao = true;
   float ssao_radius_px = 10.0f;
   float ssao_strength = 0.8f;

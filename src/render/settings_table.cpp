@@ -83,6 +83,8 @@ bool isCulled(const RenderSettings& s) { return isCompute(s) && s.culling != Cul
 bool isSolid(const RenderSettings& s) { return s.color == ColorMode::Solid; }
 bool isScalar(const RenderSettings& s) { return s.color == ColorMode::Scalar; }
 bool isLit(const RenderSettings& s) { return s.lighting == Lighting::IlluminatedLines; }
+bool isPbr(const RenderSettings& s) { return s.lighting == Lighting::Pbr; }
+bool hasAmbient(const RenderSettings& s) { return s.lighting != Lighting::None; }
 bool hasSsao(const RenderSettings& s) { return s.ssao; }
 
 std::vector<SettingInfo> makeTable() {
@@ -130,11 +132,11 @@ std::vector<SettingInfo> makeTable() {
                      "How far unselected fibers fade towards the background when there is a selection (0: not, "
                      "1: invisible)",
                      &RenderSettings::dim_unselected, 0, 1));
-  t.push_back(choice("lighting", "lighting", "illuminated | none", 2,
+  t.push_back(choice("lighting", "lighting", "illuminated | none | pbr (Cook-Torrance under a ring of 30 lights)", 3,
                      [](int v) { return lightingName(Lighting(v)); }, getChoice<Lighting, &RenderSettings::lighting>,
                      setChoice<Lighting, &RenderSettings::lighting>));
   t.push_back(with(number("ambient", "ambient", "Ambient light coefficient", &RenderSettings::light_ambient, 0, 4),
-                   isLit));
+                   hasAmbient));
   t.push_back(with(number("diffuse", "diffuse", "Diffuse light coefficient", &RenderSettings::light_diffuse, 0, 4),
                    isLit));
   t.push_back(
@@ -142,6 +144,15 @@ std::vector<SettingInfo> makeTable() {
            isLit));
   t.push_back(with(number("shininess", "shininess", "Specular exponent", &RenderSettings::light_shininess, 1, 256),
                    isLit));
+  t.push_back(with(number("roughness", "roughness", "PBR surface roughness (GGX; 0.05 to 1)",
+                          &RenderSettings::pbr_roughness, 0.05, 1),
+                   isPbr));
+  t.push_back(with(number("metalness", "metalness", "PBR metalness (0: dielectric, 1: metal)",
+                          &RenderSettings::pbr_metalness, 0, 1),
+                   isPbr));
+  t.push_back(with(number("light-intensity", "light intensity", "PBR: total radiance of the ring of lights",
+                          &RenderSettings::pbr_intensity, 0, 64),
+                   isPbr));
   t.push_back(flag("ssao", "ambient occlusion", "Screen-space ambient occlusion", &RenderSettings::ssao));
   t.push_back(with(number("ssao-radius", "AO radius", "SSAO sampling radius in pixels (the smallest scale)",
                           &RenderSettings::ssao_radius_px, 1, 64, "px"),

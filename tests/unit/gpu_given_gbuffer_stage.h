@@ -41,11 +41,46 @@ class GivenGBufferStage final : public FrameStage {
   uint32_t fiber_count_;
 };
 
-// setup, the given G-buffer, then the standard shading stages.
-inline FrameStageList givenGBufferStages(const std::vector<shader::GBufferTexel>& texels, uint32_t fiber_count) {
+// A surface stage that copies a surface target made on the host (one
+// SurfaceTexel per pixel) into the frame's, for the merge to take.
+class GivenSurfaceStage final : public FrameStage {
+ public:
+  GivenSurfaceStage(const gpu::VulkanContext& context, const std::vector<shader::SurfaceTexel>& texels) {
+    staging_ = gpu::createBuffer(context, texels.size() * sizeof(texels[0]), gpu::MemoryUse::DeviceLocal);
+    gpu::uploadToBuffer(context, staging_, texels.data(), texels.size() * sizeof(texels[0]));
+  }
+  void destroy(const gpu::VulkanContext& context) override { gpu::destroyBuffer(context, staging_); }
+  uint32_t maxPasses() const override { return 1; }
+  bool runs(const FrameContext&) const override { return true; }
+  bool drawsSurfaces() const override { return true; }
+  void record(FrameContext& frame) override {
+    // After the setup stage's clear of the same buffer.
+    gpu::recordBarrier(frame.cmd, {VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                   VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT});
+    gpu::PassScope pass(frame.cmd, frame.timer, "given surfaces",
+                        {VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                         VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, gpu::kStorageReadWrite});
+    const VkBufferCopy region{0, 0, staging_.size};
+    vkCmdCopyBuffer(frame.cmd, staging_.buffer, frame.targets.surface.buffer, 1, &region);
+  }
+
+ private:
+  gpu::Buffer staging_;
+};
+
+// setup, the given G-buffer (and, when given, surface target and the
+// merge), then the standard shading stages.
+inline FrameStageList givenGBufferStages(const std::vector<shader::GBufferTexel>& texels, uint32_t fiber_count,
+                                         const std::vector<shader::SurfaceTexel>& surfaces = {}) {
   FrameStageList list = {makeSetupStage, [texels, fiber_count](const gpu::VulkanContext& context) {
                            return std::make_unique<GivenGBufferStage>(context, texels, fiber_count);
                          }};
+  if (!surfaces.empty()) {
+    list.push_back([surfaces](const gpu::VulkanContext& context) {
+      return std::make_unique<GivenSurfaceStage>(context, surfaces);
+    });
+    list.push_back(makeSurfaceMergeStage);
+  }
   for (FrameStageFactory& f : shadingStages()) list.push_back(std::move(f));
   return list;
 }

@@ -407,6 +407,156 @@ TEST_F(GpuShade, aLinePerpendicularToLightAndEyeGetsTheHighlight) {
   expectNear(lit, quantize(expectedColor(c, s, texels[0])), "highlight");
 }
 
+// PBR's promise (shared/shade_push.h), in double precision and written
+// from the formulas: Cook-Torrance with GGX, Schlick-GGX/Smith and
+// Fresnel-Schlick under 30 directional lights on a ring at 45 degrees
+// around the direction towards the eye (camera frame), plus ambient.
+Rgb expectedPbr(const Camera& camera, const RenderSettings& s, V3 n, V3 v, Rgb albedo) {
+  const double pi = 3.14159265358979323846;
+  const auto axes = viewAxes(camera);
+  const double rough = s.pbr_roughness, metal = s.pbr_metalness;
+  const double a2 = std::pow(rough, 4.0), k = (rough + 1) * (rough + 1) / 8;
+  auto g1 = [k](double x) { return x / (x * (1 - k) + k); };
+  const double nv = std::max(0.0, dot(n, v));
+  Rgb c{};
+  for (int ch = 0; ch < 3; ++ch) c[ch] = s.light_ambient * albedo[ch];
+  for (int i = 0; i < 30; ++i) {
+    const double azimuth = 2 * pi * i / 30, polar = pi / 4;
+    V3 l{};
+    for (int j = 0; j < 3; ++j)
+      l[j] = std::sin(polar) * (std::cos(azimuth) * axes[0][j] + std::sin(azimuth) * axes[1][j]) +
+             std::cos(polar) * axes[2][j];
+    const double nl = dot(n, l);
+    if (nl <= 0) continue;
+    const V3 h = normalized({l[0] + v[0], l[1] + v[1], l[2] + v[2]});
+    const double nh = std::max(0.0, dot(n, h)), hv = std::max(0.0, dot(h, v));
+    const double d = a2 / (pi * std::pow(nh * nh * (a2 - 1) + 1, 2));
+    const double g = g1(nv) * g1(nl);
+    for (int ch = 0; ch < 3; ++ch) {
+      const double f0 = 0.04 * (1 - metal) + albedo[ch] * metal;
+      const double f = f0 + (1 - f0) * std::pow(1 - hv, 5);
+      const double diffuse = (1 - f) * (1 - metal) * albedo[ch] / pi;
+      const double specular = d * g * f / std::max(4 * nl * nv, 1e-4);
+      c[ch] += (diffuse + specular) * s.pbr_intensity / 30 * nl;
+    }
+  }
+  return c;
+}
+
+// The line's view-facing normal (in the plane of T and V), as PBR lights it.
+V3 viewFacingNormal(V3 t, V3 v) {
+  t = normalized(t);
+  const double vt = dot(v, t);
+  const V3 n = {v[0] - vt * t[0], v[1] - vt * t[1], v[2] - vt * t[2]};
+  return std::sqrt(dot(n, n)) > 1e-3 ? normalized(n) : v;
+}
+
+TEST_F(GpuShade, pbrLinesMatchTheCpuCookTorrance) {
+  RenderSettings s;
+  s.lighting = Lighting::Pbr;
+  s.ssao = false;
+  const std::vector<Texel> texels = sampleTexels();
+  const Camera c = camera();
+  struct Material {
+    float roughness, metalness, intensity;
+  };
+  // Rough dielectric, the defaults, glossy metal (large, narrow highlights),
+  // and a half-metal under a dimmer ring.
+  for (Material m : {Material{1.0f, 0.0f, 3.14159265f}, Material{0.5f, 0.0f, 3.14159265f},
+                     Material{0.15f, 1.0f, 3.14159265f}, Material{0.3f, 0.5f, 2.0f}})
+    for (ColorMode mode : {ColorMode::Solid, ColorMode::Orientation}) {
+      SCOPED_TRACE("roughness " + std::to_string(m.roughness) + " metalness " + std::to_string(m.metalness) + " " +
+                   std::string(colorModeName(mode)));
+      s.pbr_roughness = m.roughness;
+      s.pbr_metalness = m.metalness;
+      s.pbr_intensity = m.intensity;
+      s.color = mode;
+      s.solid_color = {0.8f, 0.5f, 0.2f};
+      const std::vector<uint8_t> rgba = shade(texels, s);
+      for (const Texel& t : texels) {
+        const V3 tangent = normalized(t.tangent), v = towardsEye(c, t);
+        const Rgb albedo = mode == ColorMode::Solid ? Rgb{s.solid_color[0], s.solid_color[1], s.solid_color[2]}
+                                                    : Rgb{std::fabs(tangent[0]), std::fabs(tangent[1]),
+                                                          std::fabs(tangent[2])};
+        const auto want = quantize(expectedPbr(c, s, viewFacingNormal(tangent, v), v, albedo));
+        const auto got = pixel(rgba, t.x, t.y);
+        for (int k = 0; k < 3; ++k)
+          EXPECT_LE(std::abs(int(got[k]) - int(want[k])), 1)
+              << "texel (" << t.x << ", " << t.y << ") channel " << k << ": got " << int(got[k]) << " want "
+              << int(want[k]);
+      }
+    }
+}
+
+TEST_F(GpuShade, pbrSurfacesAreLitFromTheirNormal) {
+  // Surface texels (a tube's) with normals facing the eye, across it and
+  // away from it (the shade pass turns those towards the eye), through the
+  // merge, against the same formulas with the surface's own normal.
+  RenderSettings s;
+  s.lighting = Lighting::Pbr;
+  s.ssao = false;
+  s.color = ColorMode::Solid;
+  s.solid_color = {0.3f, 0.6f, 0.9f};
+  s.pbr_roughness = 0.35f;
+  s.pbr_metalness = 0.2f;
+  const Camera c = camera();
+  const auto axes = viewAxes(c);
+  std::vector<shader::GBufferTexel> gbuffer(kSize * kSize, {1.0f, shader::kNoFiberId, 0, 0});
+  std::vector<shader::SurfaceTexel> surfaces(kSize * kSize, shader::SurfaceTexel{1.0f, shader::kNoFiberId});
+  struct Case {
+    uint32_t x, y;
+    V3 normal;
+  };
+  std::vector<Case> cases;
+  const double w[][3] = {{0, 0, 1}, {0.6, 0.3, 0.74}, {-0.9, 0.1, 0.42}, {0.2, -0.95, 0.24}, {0.3, 0.2, -0.93}};
+  uint32_t i = 0;
+  for (const auto& m : w) {
+    V3 n{};
+    for (int j = 0; j < 3; ++j) n[j] = m[0] * axes[0][j] + m[1] * axes[1][j] + m[2] * axes[2][j];
+    cases.push_back({4 + 5 * i, 6 + 4 * i, normalized(n)});
+    ++i;
+  }
+  for (const Case& k : cases) {
+    shader::SurfaceTexel& t = surfaces[k.y * kSize + k.x];
+    t.depth = clipDepth(c, 100.0);
+    t.fiber = 3;
+    t.normal = packTangent(k.normal);
+    t.tangent = packTangent({1, 0, 0});
+    t.source = shader::kSurfaceSourceTube;
+  }
+  FrameRenderer renderer(context(), c.width, c.height, test::givenGBufferStages(gbuffer, 0, surfaces));
+  renderer.render(c, s, GpuScene{});
+  const std::vector<uint8_t> rgba = downloadColor(context(), renderer.targets());
+  for (const Case& k : cases) {
+    const V3 v = towardsEye(c, {k.x, k.y, {1, 0, 0}, 100.0, 3});
+    V3 n = k.normal;
+    if (dot(n, v) < 0) n = {-n[0], -n[1], -n[2]};
+    const auto want =
+        quantize(expectedPbr(c, s, n, v, {s.solid_color[0], s.solid_color[1], s.solid_color[2]}));
+    const auto got = pixel(rgba, k.x, k.y);
+    for (int ch = 0; ch < 3; ++ch)
+      EXPECT_LE(std::abs(int(got[ch]) - int(want[ch])), 1)
+          << "surface texel (" << k.x << ", " << k.y << ") channel " << ch << ": got " << int(got[ch]) << " want "
+          << int(want[ch]);
+  }
+  // A normal facing the eye is lit by the whole ring; one at 65 degrees
+  // from it by fewer lights, so it is darker.
+  EXPECT_GT(luminance(pixel(rgba, cases[0].x, cases[0].y)), luminance(pixel(rgba, cases[2].x, cases[2].y)));
+}
+
+TEST_F(GpuShade, pbrParametersOutOfRangeAreRejected) {
+  RenderSettings s;
+  s.lighting = Lighting::Pbr;
+  s.pbr_roughness = 0.0f;
+  EXPECT_THROW(shade({}, s), Error);
+  s.pbr_roughness = 0.5f;
+  s.pbr_metalness = 1.5f;
+  EXPECT_THROW(shade({}, s), Error);
+  s.pbr_metalness = 0.5f;
+  s.pbr_intensity = -1.0f;
+  EXPECT_THROW(shade({}, s), Error);
+}
+
 // A straight line of fiber 7 across the frame, receding in depth from 60 to
 // 140 mm, with no other fiber.
 std::vector<Texel> isolatedLine() {
@@ -587,7 +737,7 @@ TEST_F(GpuShade, wholePhantomFramesInEveryModeAreShaded) {
   RenderSettings s;
   s.culling = CullingMode::None;
   for (ColorMode mode : {ColorMode::Solid, ColorMode::Orientation, ColorMode::PerFiber})
-    for (Lighting lighting : {Lighting::None, Lighting::IlluminatedLines})
+    for (Lighting lighting : {Lighting::None, Lighting::IlluminatedLines, Lighting::Pbr})
       for (bool ssao : {false, true}) {
         SCOPED_TRACE(std::string(colorModeName(mode)) + " " + std::string(lightingName(lighting)) +
                      (ssao ? " ssao" : ""));

@@ -17,7 +17,7 @@
 namespace fibscope {
 namespace {
 
-constexpr uint32_t kColorModes = 5, kLightings = 2;
+constexpr uint32_t kColorModes = 5, kLightings = 3;
 // What the frame's surfaces ask of the shade pass.
 constexpr uint32_t kNoSurfaces = 0, kOpaqueSurfaces = 1, kTranslucentSlices = 2, kSurfaceKinds = 3;
 
@@ -33,7 +33,12 @@ uint32_t shaderColorMode(ColorMode mode) {
 }
 
 uint32_t shaderLighting(Lighting lighting) {
-  return lighting == Lighting::IlluminatedLines ? shader::kShadeLightingIlluminated : shader::kShadeLightingNone;
+  switch (lighting) {
+    case Lighting::None: return shader::kShadeLightingNone;
+    case Lighting::IlluminatedLines: return shader::kShadeLightingIlluminated;
+    case Lighting::Pbr: return shader::kShadeLightingPbr;
+  }
+  return shader::kShadeLightingNone;
 }
 
 class ShadeStage final : public FrameStage {
@@ -68,6 +73,9 @@ class ShadeStage final : public FrameStage {
     block.scalar_max = s.scalar_max;
     block.highlight = packRgba8(s.highlight_color);
     block.dim_unselected = s.dim_unselected;
+    block.roughness = s.pbr_roughness;
+    block.metalness = s.pbr_metalness;
+    block.light_intensity = s.pbr_intensity;
     const size_t table = size_t(s.colormap) * kColormapEntries;
     std::copy(colormaps_.begin() + table, colormaps_.begin() + table + kColormapEntries, block.colormap);
     // The previous frame's reads of the block before the update, the
