@@ -1,6 +1,6 @@
 // Screen-space ambient occlusion for lines (DESIGN.md section 6, "Shading").
 // Lines have no surface normal, so instead of a normal-oriented hemisphere
-// each covered pixel looks at kSsaoSamples G-buffer neighbours on a disc of
+// each covered pixel looks at `samples` G-buffer neighbours on a disc of
 // radius_px around it (a Vogel spiral, turned by one of 16 angles set by the
 // pixel's place in a 4 x 4 tile, so neighbouring pixels sample different
 // directions and the 5-tap blur averages all 16) and counts those of
@@ -15,8 +15,10 @@
 //   - Neighbours of the same fiber never occlude, so a lone fiber over an
 //     empty background stays exactly 1 however it turns in depth.
 // ao = 1 - strength * (weighted occluders / total weight); 1 where empty.
-// Multi-scale AO (FiberVisualizer): with scales > 1 the same again on discs
-// of 2, 4, 8 times the radius, the factors multiplied: contact shadows from
+// Multi-scale AO (FiberVisualizer section 11.3): with scales > 1 the same
+// again on discs of 2, 4, 8, 16 times the radius, each with half the
+// previous scale's samples (a wider disc's occluders are whole bundles,
+// which fewer samples find), the factors multiplied: contact shadows from
 // the first scale, whole bundles darkening those behind from the last.
 #version 460
 #extension GL_GOOGLE_include_directive : require
@@ -57,9 +59,10 @@ void main() {
     for (uint k = 0u; k < pc.scales; ++k) {
       const float radius = pc.radius_px * float(1u << k);
       const float turn = rotation + float(k) * kGoldenAngle;
+      const uint samples = max(pc.samples >> k, kSsaoMinSamples);
       float occluded = 0.0, total = 0.0;
-      for (uint i = 0u; i < kSsaoSamples; ++i) {
-        const float r = radius * sqrt((float(i) + 0.5) / float(kSsaoSamples));
+      for (uint i = 0u; i < samples; ++i) {
+        const float r = radius * sqrt((float(i) + 0.5) / float(samples));
         const float a = float(i) * kGoldenAngle + turn;
         const float weight = 1.0 - 0.5 * r / radius;
         total += weight;

@@ -59,11 +59,25 @@ SHADE_CONST float kPbrMinDenominator = 1e-4f;
 // in pixels: 2, with weights 1 2 2 2 1, gives each of the 4 phases of the
 // tile the same weight along a row and along a column, so on a region of
 // one depth the two blur passes average the 16 rotations exactly.
-SHADE_CONST uint kSsaoSamples = 16u;
+// The smallest scale takes RenderSettings::ao_samples neighbours (at most
+// kSsaoMaxSamples), each larger scale half as many as the one before, never
+// fewer than kSsaoMinSamples (FiberVisualizer section 11.3: 64 at the
+// smallest scale, halved at each larger one).
+SHADE_CONST uint kSsaoMaxSamples = 64u;
+SHADE_CONST uint kSsaoMinSamples = 4u;
 SHADE_CONST uint kSsaoRotations = 16u;
 SHADE_CONST uint kSsaoBlurRadius = 2u;
-// RenderSettings::ao_scales at most: radii r, 2r, 4r, 8r.
-SHADE_CONST uint kSsaoMaxScales = 4u;
+// RenderSettings::ao_scales at most: radii r, 2r, 4r, 8r, 16r (the paper's
+// 3 to 50 px over up to 5 scales is r = 3: 3, 6, 12, 24, 48).
+SHADE_CONST uint kSsaoMaxScales = 5u;
+// Neighbours nearer than this (mm) do not occlude (SsaoPush::epsilon_mm):
+// fibers side by side in a bundle are at most a few tenths of a millimetre
+// apart in depth across a few pixels.
+SHADE_CONST float kSsaoEpsilonMm = 0.3f;
+// The blur mixes pixels within this distance in depth
+// (SsaoBlurPush::depth_tolerance_mm): the same layer of a bundle, not an
+// occluder with the fiber it darkens.
+SHADE_CONST float kSsaoBlurDepthToleranceMm = 1.0f;
 
 // The headlight: the direction towards the light in VIEW space (x right,
 // y up, +z towards the viewer), a little above and to the left of the eye so
@@ -90,13 +104,14 @@ struct TileClassifyPush {
   uint height;
 };
 
-// ssao.comp: per covered pixel, the fraction of kSsaoSamples neighbours
+// ssao.comp: per covered pixel, the fraction of `samples` neighbours
 // within radius_px that lie nearer the camera than the pixel by more than
 // epsilon_mm and less than range_mm (a smooth falloff ends at range_mm),
 // weighted by closeness; ao = 1 - strength * fraction. Empty pixels get 1.
 // Multi-scale (scales > 1): the same at radius_px * 2^k for k = 0 ..
-// scales - 1 (each scale's spiral turned by a further golden angle), and
-// ao = the product of the per-scale factors, so more scales never lighten.
+// scales - 1 with max(samples >> k, kSsaoMinSamples) neighbours (each
+// scale's spiral turned by a further golden angle), and ao = the product of
+// the per-scale factors, so more scales never lighten.
 // Anatomical slices (fiber kNoFiberObject) take none (1) and cast none.
 struct SsaoPush {
   uint64_t camera;   // CameraBlock: depth_range linearises the clip depth
@@ -109,8 +124,8 @@ struct SsaoPush {
   float epsilon_mm;
   float range_mm;
   float strength;
-  uint scales;  // 1 .. kSsaoMaxScales
-  uint pad0;
+  uint scales;   // 1 .. kSsaoMaxScales
+  uint samples;  // the smallest scale's, kSsaoMinSamples .. kSsaoMaxSamples
 };
 
 // ssao_blur.comp: ao_out = the average of ao_in over the 2 * kSsaoBlurRadius

@@ -160,13 +160,22 @@ std::vector<SettingInfo> makeTable() {
   t.push_back(with(number("ssao-strength", "AO strength", "How dark full occlusion gets (0 to 1)",
                           &RenderSettings::ssao_strength, 0, 1),
                    hasSsao));
-  SettingInfo scales = entry("ao-scales", "AO scales", "Multi-scale AO: 1 to 4 radii (r, 2r, 4r, 8r)",
+  SettingInfo scales = entry("ao-scales", "AO scales",
+                             "Multi-scale AO: 1 to 5 radii (r, 2r, 4r, 8r, 16r; the paper: radius 3, 5 scales)",
                              SettingKind::Integer);
   scales.integer = &RenderSettings::ao_scales;
   scales.min = 1;
   scales.max = shader::kSsaoMaxScales;
   scales.relevant = hasSsao;
   t.push_back(scales);
+  SettingInfo samples = entry("ao-samples", "AO samples",
+                              "AO samples at the smallest scale, halved at each larger one (the paper: 64)",
+                              SettingKind::Integer);
+  samples.integer = &RenderSettings::ao_samples;
+  samples.min = shader::kSsaoMinSamples;
+  samples.max = shader::kSsaoMaxSamples;
+  samples.relevant = hasSsao;
+  t.push_back(samples);
   t.push_back(with(number("ssao-range", "AO range",
                           "Neighbours nearer than this (view distance) no longer occlude, in mm",
                           &RenderSettings::ssao_range_mm, 0.5, 200, "mm"),

@@ -12,14 +12,6 @@
 namespace fibscope {
 namespace {
 
-// Neighbours nearer than this (mm) do not occlude: fibers side by side in a
-// bundle are at most a few tenths of a millimetre apart in depth across a
-// few pixels.
-constexpr float kSsaoEpsilonMm = 0.3f;
-// The blur mixes pixels within this distance in depth: the same layer of a
-// bundle, not an occluder with the fiber it darkens.
-constexpr float kSsaoBlurDepthToleranceMm = 1.0f;
-
 class SsaoStage final : public FrameStage {
  public:
   explicit SsaoStage(const gpu::VulkanContext& context) {
@@ -52,10 +44,11 @@ class SsaoStage final : public FrameStage {
       push.width = t.width;
       push.height = t.height;
       push.radius_px = s.ssao_radius_px;
-      push.epsilon_mm = kSsaoEpsilonMm;
+      push.epsilon_mm = shader::kSsaoEpsilonMm;
       push.range_mm = s.ssao_range_mm;
       push.strength = s.ssao_strength;
       push.scales = uint32_t(s.ao_scales);
+      push.samples = uint32_t(s.ao_samples);
       gpu::recordDispatchIndirect(frame.cmd, ssao_, push, t.tile_list.buffer);
     }
     gpu::PassScope pass(frame.cmd, frame.timer, "ssao blur", gpu::kComputeToCompute);
@@ -65,7 +58,7 @@ class SsaoStage final : public FrameStage {
     blur.tiles = t.tile_list.address;
     blur.width = t.width;
     blur.height = t.height;
-    blur.depth_tolerance_mm = kSsaoBlurDepthToleranceMm;
+    blur.depth_tolerance_mm = shader::kSsaoBlurDepthToleranceMm;
     blur.ao_in = t.ao.address;
     blur.ao_out = t.ao_blur.address;
     blur.step_x = 1;
