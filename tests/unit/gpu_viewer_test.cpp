@@ -72,7 +72,7 @@ TEST(ViewerScript, malformedLinesNameTheFileAndLine) {
        {"orbit 1", "orbit a b", "pan 1 2 3", "dolly", "view top", "fov 5", "fov 120", "set color red",
         "set width 9", "set ssao maybe", "set background 2,0,0", "set speed 3", "wait 0", "wait 1.5",
         "screenshot out.jpg", "screenshot out.png 0x5", "quit now", "jump 3", "orbit nan 1", "resize 400",
-        "resize 8 8", "resize 400.5 300", "resize 20000 300", "set ao-scales 5", "set colormap jet",
+        "resize 8 8", "resize 400.5 300", "resize 20000 300", "set ao-scales 6", "set colormap jet",
         "set scalar-range 5,1", "set fxaa maybe", "set dim 2"}) {
     SCOPED_TRACE(bad);
     try {
