@@ -62,14 +62,6 @@ vec3 viewNormalColor(CameraBlock cam, vec3 n) {
   return 0.5 + 0.5 * vec3(dot(n, cameraRight(cam)), dot(n, cameraUp(cam)), dot(n, cameraBack(cam)));
 }
 
-
-// Light i of the PBR ring in world space (shared/shade_push.h).
-vec3 ringLightDirection(CameraBlock cam, uint i) {
-  const float azimuth = 6.28318531 * float(i) / float(kPbrLights);
-  const float s = sin(kPbrRingPolar);
-  return s * cos(azimuth) * cameraRight(cam) + s * sin(azimuth) * cameraUp(cam) + cos(kPbrRingPolar) * cameraBack(cam);
-}
-
 // Cook-Torrance (GGX, Schlick-GGX/Smith, Fresnel-Schlick) summed over the
 // ring, plus the ambient term (formulas: shared/shade_push.h).
 vec3 pbrColor(ShadeBlockRef block, CameraBlock cam, vec3 albedo, vec3 n, vec3 v) {
@@ -80,9 +72,16 @@ vec3 pbrColor(ShadeBlockRef block, CameraBlock cam, vec3 albedo, vec3 n, vec3 v)
   const float nv = max(dot(n, v), 0.0);
   const float g1v = nv / (nv * (1.0 - k) + k);
   const float radiance = block.b.light_intensity / float(kPbrLights);
+  // The ring (shared/shade_push.h) in world space: light i is
+  // cos(polar) back + sin(polar) (cos(phi_i) right + sin(phi_i) up); phi
+  // steps by a constant rotation, so a pixel takes no sine per light.
+  const vec3 axis = cos(kPbrRingPolar) * cameraBack(cam);
+  const vec3 right = sin(kPbrRingPolar) * cameraRight(cam), up = sin(kPbrRingPolar) * cameraUp(cam);
+  const float step_c = cos(6.28318531 / float(kPbrLights)), step_s = sin(6.28318531 / float(kPbrLights));
+  vec2 phi = vec2(1.0, 0.0);  // (cos, sin) of light i's azimuth
   vec3 sum = vec3(0.0);
-  for (uint i = 0u; i < kPbrLights; ++i) {
-    const vec3 l = ringLightDirection(cam, i);
+  for (uint i = 0u; i < kPbrLights; ++i, phi = vec2(phi.x * step_c - phi.y * step_s, phi.y * step_c + phi.x * step_s)) {
+    const vec3 l = axis + phi.x * right + phi.y * up;
     const float nl = dot(n, l);
     if (nl <= 0.0) continue;
     const vec3 h = normalize(l + v);

@@ -155,6 +155,20 @@ std::array<V3, 3> viewAxes(const Camera& camera) {
   return {right, cross(back, right), back};
 }
 
+// A view-space vector (x right, y up, z towards the eye) in world space.
+V3 viewToWorld(const Camera& camera, V3 w) {
+  const auto axes = viewAxes(camera);
+  V3 out{};
+  for (int j = 0; j < 3; ++j) out[j] = w[0] * axes[0][j] + w[1] * axes[1][j] + w[2] * axes[2][j];
+  return out;
+}
+
+// The headlight (kShadeLightView*) in world space.
+V3 headlight(const Camera& camera) {
+  return viewToWorld(camera,
+                     normalized({shader::kShadeLightViewX, shader::kShadeLightViewY, shader::kShadeLightViewZ}));
+}
+
 // ColorMode::Normal's promise: N = normalize(V - (V.T) T), or V for a line
 // seen end-on, in view space, as 0.5 + 0.5 N.
 Rgb expectedNormalColor(const Camera& camera, const Texel& t) {
@@ -186,13 +200,7 @@ Rgb expectedColor(const Camera& camera, const RenderSettings& s, const Texel& t,
   if (base_override) base = *base_override;
   if (s.lighting == Lighting::None) return base;
   const V3 v = towardsEye(camera, t);
-  // The light: view-space (kShadeLightView*) in the camera's look-at frame.
-  const V3 back = normalized(sub(camera.eye, camera.target));
-  const V3 right = normalized(cross(camera.up, back));
-  const V3 up = cross(back, right);
-  const V3 lv = normalized({shader::kShadeLightViewX, shader::kShadeLightViewY, shader::kShadeLightViewZ});
-  const V3 l = {lv[0] * right[0] + lv[1] * up[0] + lv[2] * back[0], lv[0] * right[1] + lv[1] * up[1] + lv[2] * back[1],
-                lv[0] * right[2] + lv[1] * up[2] + lv[2] * back[2]};
+  const V3 l = headlight(camera);
   const double lt = dot(l, tangent), vt = dot(v, tangent);
   const double diffuse = std::sqrt(std::max(0.0, 1 - lt * lt));
   const double specular =
@@ -259,9 +267,11 @@ class GpuShade : public test::GpuTest {
   }
   static double luminance(std::array<uint8_t, 4> p) { return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]; }
 
-  static void expectNear(std::array<uint8_t, 4> got, std::array<uint8_t, 4> want, const char* what) {
+  // Colour channels within `tolerance`, alpha exact.
+  static void expectNear(std::array<uint8_t, 4> got, std::array<uint8_t, 4> want, const char* what,
+                         int tolerance = 2) {
     for (int k = 0; k < 4; ++k)
-      EXPECT_LE(std::abs(int(got[k]) - int(want[k])), k == 3 ? 0 : 2)
+      EXPECT_LE(std::abs(int(got[k]) - int(want[k])), k == 3 ? 0 : tolerance)
           << what << ": channel " << k << " got " << int(got[k]) << " want " << int(want[k]);
   }
 };
@@ -392,12 +402,8 @@ TEST_F(GpuShade, aLinePerpendicularToLightAndEyeGetsTheHighlight) {
   s.color = ColorMode::Solid;
   s.solid_color = {0.5f, 0.5f, 0.5f};
   const Camera c = camera();
-  const V3 back = normalized(sub(c.eye, c.target));
-  const V3 right = normalized(cross(c.up, back));
-  const V3 up = cross(back, right);
-  const V3 lv = normalized({shader::kShadeLightViewX, shader::kShadeLightViewY, shader::kShadeLightViewZ});
-  const V3 l = {lv[0] * right[0] + lv[1] * up[0] + lv[2] * back[0], lv[0] * right[1] + lv[1] * up[1] + lv[2] * back[1],
-                lv[0] * right[2] + lv[1] * up[2] + lv[2] * back[2]};
+  const V3 back = viewAxes(c)[2];
+  const V3 l = headlight(c);
   const V3 across = normalized(cross(l, back));  // ~perpendicular to L and V at the centre
   const std::vector<Texel> texels = {{16, 16, across, 100, 1}, {20, 16, back, 100, 2}};
   const std::vector<uint8_t> rgba = shade(texels, s);
@@ -413,7 +419,6 @@ TEST_F(GpuShade, aLinePerpendicularToLightAndEyeGetsTheHighlight) {
 // around the direction towards the eye (camera frame), plus ambient.
 Rgb expectedPbr(const Camera& camera, const RenderSettings& s, V3 n, V3 v, Rgb albedo) {
   const double pi = 3.14159265358979323846;
-  const auto axes = viewAxes(camera);
   const double rough = s.pbr_roughness, metal = s.pbr_metalness;
   const double a2 = std::pow(rough, 4.0), k = (rough + 1) * (rough + 1) / 8;
   auto g1 = [k](double x) { return x / (x * (1 - k) + k); };
@@ -422,10 +427,8 @@ Rgb expectedPbr(const Camera& camera, const RenderSettings& s, V3 n, V3 v, Rgb a
   for (int ch = 0; ch < 3; ++ch) c[ch] = s.light_ambient * albedo[ch];
   for (int i = 0; i < 30; ++i) {
     const double azimuth = 2 * pi * i / 30, polar = pi / 4;
-    V3 l{};
-    for (int j = 0; j < 3; ++j)
-      l[j] = std::sin(polar) * (std::cos(azimuth) * axes[0][j] + std::sin(azimuth) * axes[1][j]) +
-             std::cos(polar) * axes[2][j];
+    const V3 l = viewToWorld(camera, {std::sin(polar) * std::cos(azimuth), std::sin(polar) * std::sin(azimuth),
+                                      std::cos(polar)});
     const double nl = dot(n, l);
     if (nl <= 0) continue;
     const V3 h = normalized({l[0] + v[0], l[1] + v[1], l[2] + v[2]});
@@ -478,12 +481,8 @@ TEST_F(GpuShade, pbrLinesMatchTheCpuCookTorrance) {
         const Rgb albedo = mode == ColorMode::Solid ? Rgb{s.solid_color[0], s.solid_color[1], s.solid_color[2]}
                                                     : Rgb{std::fabs(tangent[0]), std::fabs(tangent[1]),
                                                           std::fabs(tangent[2])};
-        const auto want = quantize(expectedPbr(c, s, viewFacingNormal(tangent, v), v, albedo));
-        const auto got = pixel(rgba, t.x, t.y);
-        for (int k = 0; k < 3; ++k)
-          EXPECT_LE(std::abs(int(got[k]) - int(want[k])), 1)
-              << "texel (" << t.x << ", " << t.y << ") channel " << k << ": got " << int(got[k]) << " want "
-              << int(want[k]);
+        expectNear(pixel(rgba, t.x, t.y), quantize(expectedPbr(c, s, viewFacingNormal(tangent, v), v, albedo)),
+                   "pbr line texel", 1);
       }
     }
 }
@@ -500,7 +499,6 @@ TEST_F(GpuShade, pbrSurfacesAreLitFromTheirNormal) {
   s.pbr_roughness = 0.35f;
   s.pbr_metalness = 0.2f;
   const Camera c = camera();
-  const auto axes = viewAxes(c);
   std::vector<shader::GBufferTexel> gbuffer(kSize * kSize, {1.0f, shader::kNoFiberId, 0, 0});
   std::vector<shader::SurfaceTexel> surfaces(kSize * kSize, shader::SurfaceTexel{1.0f, shader::kNoFiberId});
   struct Case {
@@ -511,9 +509,7 @@ TEST_F(GpuShade, pbrSurfacesAreLitFromTheirNormal) {
   const double w[][3] = {{0, 0, 1}, {0.6, 0.3, 0.74}, {-0.9, 0.1, 0.42}, {0.2, -0.95, 0.24}, {0.3, 0.2, -0.93}};
   uint32_t i = 0;
   for (const auto& m : w) {
-    V3 n{};
-    for (int j = 0; j < 3; ++j) n[j] = m[0] * axes[0][j] + m[1] * axes[1][j] + m[2] * axes[2][j];
-    cases.push_back({4 + 5 * i, 6 + 4 * i, normalized(n)});
+    cases.push_back({4 + 5 * i, 6 + 4 * i, normalized(viewToWorld(c, {m[0], m[1], m[2]}))});
     ++i;
   }
   for (const Case& k : cases) {
@@ -531,13 +527,9 @@ TEST_F(GpuShade, pbrSurfacesAreLitFromTheirNormal) {
     const V3 v = towardsEye(c, {k.x, k.y, {1, 0, 0}, 100.0, 3});
     V3 n = k.normal;
     if (dot(n, v) < 0) n = {-n[0], -n[1], -n[2]};
-    const auto want =
-        quantize(expectedPbr(c, s, n, v, {s.solid_color[0], s.solid_color[1], s.solid_color[2]}));
-    const auto got = pixel(rgba, k.x, k.y);
-    for (int ch = 0; ch < 3; ++ch)
-      EXPECT_LE(std::abs(int(got[ch]) - int(want[ch])), 1)
-          << "surface texel (" << k.x << ", " << k.y << ") channel " << ch << ": got " << int(got[ch]) << " want "
-          << int(want[ch]);
+    expectNear(pixel(rgba, k.x, k.y),
+               quantize(expectedPbr(c, s, n, v, {s.solid_color[0], s.solid_color[1], s.solid_color[2]})),
+               "pbr surface texel", 1);
   }
   // A normal facing the eye is lit by the whole ring; one at 65 degrees
   // from it by fewer lights, so it is darker.
