@@ -13,6 +13,7 @@
 #include "codec/fbl_file.h"
 #include "core/error.h"
 #include "core/progress.h"
+#include "io/fiber_density.h"
 #include "io/reader.h"
 #include "io/tractogram_stats.h"
 
@@ -163,25 +164,31 @@ void printFbl(const FblInfo& f) {
 struct InfoResult {
   TractogramHeader header;
   TractogramStats stats;
+  std::optional<FiberDensity> density;
   uint64_t bytes = 0;
   std::vector<std::string> warnings;
 };
 
-InfoResult inspect(const std::string& path, bool terminal_progress) {
+// density_voxel_mm 0: no density statistic.
+InfoResult inspect(const std::string& path, bool terminal_progress, double density_voxel_mm) {
   InfoResult r;
   r.bytes = pathBytes(path);
   auto reader = openInput(path);
   Progress progress("reading " + std::filesystem::path(path).filename().string(), double(r.bytes), "bytes",
                     terminal_progress);
   TractogramStatsAccumulator acc;
+  std::optional<FiberDensityAccumulator> density;
+  if (density_voxel_mm > 0) density.emplace(density_voxel_mm);
   Tractogram chunk;
   while (reader->read(chunk)) {
     acc.add(chunk);
+    if (density) density->add(chunk);
     progress.set(double(reader->bytesRead()));
   }
   progress.finish();
   r.header = reader->header();
   r.stats = acc.result();
+  if (density) r.density = density->result();
   r.warnings = reader->warnings();
   return r;
 }
@@ -214,6 +221,16 @@ nlohmann::json toJson(const std::string& path, const InfoResult& r, const std::o
     j["voxel_to_rasmm"] = r.header.space.voxel_to_rasmm;
     j["dimensions"] = r.header.space.dimensions;
     j["voxel_sizes"] = r.header.space.voxel_sizes;
+  }
+  if (r.density) {
+    const FiberDensity& d = *r.density;
+    j["fiber_density"] = {{"voxel_mm", d.voxel_mm},
+                          {"occupied_voxels", d.occupied_voxels},
+                          {"occupied_cm3", d.occupied_cm3},
+                          {"fibers_per_voxel",
+                           {{"mean", d.mean}, {"median", d.median}, {"p90", d.p90}, {"p99", d.p99}, {"max", d.max}}},
+                          {"single_fiber_fraction", d.single_fiber_fraction},
+                          {"histogram_log2", d.histogram}};
   }
   j["warnings"] = r.warnings;
   if (fbl) j["fbl"] = fblJson(*fbl);
@@ -249,6 +266,15 @@ void printText(const std::string& path, const InfoResult& r, const std::optional
   std::printf("  length (mm)           min %.3f  mean %.3f  max %.3f\n", s.length_min, s.length_mean, s.length_max);
   std::printf("  per-streamline data   %s\n", arrayList(r.header.per_streamline).c_str());
   std::printf("  per-point data        %s\n", arrayList(r.header.per_point).c_str());
+  if (r.density) {
+    const FiberDensity& d = *r.density;
+    std::printf("  fiber density         %llu voxels of %.3g mm occupied (%.4g cm3); fibers per voxel mean %.3g  "
+                "median %llu  p90 %llu  p99 %llu  max %llu  (%.1f %% of voxels one fiber)\n",
+                static_cast<unsigned long long>(d.occupied_voxels), d.voxel_mm, d.occupied_cm3, d.mean,
+                static_cast<unsigned long long>(d.median), static_cast<unsigned long long>(d.p90),
+                static_cast<unsigned long long>(d.p99), static_cast<unsigned long long>(d.max),
+                100.0 * d.single_fiber_fraction);
+  }
   if (!r.header.groups.empty()) {
     std::printf("  groups               ");
     for (const auto& g : r.header.groups) std::printf(" %s (%zu)", g.name.c_str(), g.streamlines.size());
@@ -262,11 +288,16 @@ void addInfoCommand(CLI::App& app) {
   struct Options {
     std::vector<std::string> files;
     bool json = false;
+    double density_voxel_mm = 1.0;
   };
   auto opt = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand("info", "Counts, step, turning angle, extent and data of tractogram files");
   cmd->add_option("files", opt->files, "Tractogram files (.tck .trk .trx .vtk .fbl)")->required();
   cmd->add_flag("--json", opt->json, "Print one JSON document for all files");
+  cmd->add_option("--density-voxel", opt->density_voxel_mm,
+                  "Voxel size in mm of the fiber density statistic (distinct fibers per occupied voxel); 0: off")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 100.0));
   cmd->callback([opt] {
     nlohmann::json all = nlohmann::json::array();
     for (const auto& path : opt->files) {
@@ -274,7 +305,7 @@ void addInfoCommand(CLI::App& app) {
       if (isFblPath(path)) fbl = inspectFbl(path);
       InfoResult r;
       try {
-        r = inspect(path, !opt->json);
+        r = inspect(path, !opt->json, opt->density_voxel_mm);
       } catch (const Error&) {
         // Show the container (which section is damaged) before the error.
         if (fbl && !opt->json) {

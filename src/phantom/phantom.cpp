@@ -22,7 +22,8 @@ namespace {
 
 constexpr std::array<std::string_view, kPhantomBundleCount> kBundleNames = {
     "corpus_callosum", "cst_left",  "cst_right",  "arcuate_left", "arcuate_right", "cingulum_left",
-    "cingulum_right",  "ifof_left", "ifof_right", "ilf_left",     "ilf_right",     "u_fibers"};
+    "cingulum_right",  "ifof_left", "ifof_right", "ilf_left",     "ilf_right",     "u_fibers",
+    "wm_commissural",  "wm_association", "wm_projection"};
 
 // Shares chosen so that the mean fiber is about 86 mm long, as in the
 // fiblets paper's 500 k iFOD1 tractogram (0.43 G segments at 0.1 mm).
@@ -34,6 +35,7 @@ constexpr std::array<double, kPhantomBundleCount> kDefaultWeights = {
     0.04,  0.04,   // IFOF
     0.035, 0.035,  // ILF
     0.20,          // U-fibers
+    0.0,   0.0,  0.0,  // the white matter at large: off unless asked (applyWholeBrainPhantomMix)
 };
 
 constexpr double kGuideSpacingMm = 1.0;
@@ -74,7 +76,17 @@ int phantomBundleIndex(std::string_view name) {
 
 const std::array<double, kPhantomBundleCount>& defaultPhantomBundleWeights() { return kDefaultWeights; }
 
+void applyWholeBrainPhantomMix(PhantomOptions& options) {
+  options.bundle_weights.assign(kDefaultWeights.begin(), kDefaultWeights.end());
+  options.bundle_weights[size_t(PhantomBundle::WhiteMatterCommissural)] = 2.1;
+  options.bundle_weights[size_t(PhantomBundle::WhiteMatterAssociation)] = 2.1;
+  options.bundle_weights[size_t(PhantomBundle::WhiteMatterProjection)] = 1.8;
+  options.bundle_radius_scale = 2.5;
+}
+
 void validatePhantomOptions(const PhantomOptions& o) {
+  check(std::isfinite(o.bundle_radius_scale) && o.bundle_radius_scale >= 0.25 && o.bundle_radius_scale <= 4.0,
+        "bundle_radius_scale must be between 0.25 and 4, got " + number(o.bundle_radius_scale));
   check(std::isfinite(o.step_mm) && o.step_mm >= 0.005 && o.step_mm <= 10.0,
         "step_mm must be between 0.005 and 10, got " + number(o.step_mm));
   check(std::isfinite(o.max_angle_deg) && o.max_angle_deg >= 1.0 && o.max_angle_deg <= 90.0,
@@ -107,8 +119,9 @@ void validatePhantomOptions(const PhantomOptions& o) {
   }
 }
 
-std::vector<double> parsePhantomBundleMix(const std::string& text) {
+std::vector<double> parsePhantomBundleMix(const std::string& text, const std::vector<double>& base) {
   std::vector<double> weights(kDefaultWeights.begin(), kDefaultWeights.end());
+  if (base.size() == kPhantomBundleCount) weights = base;
   size_t begin = 0;
   while (begin <= text.size()) {
     size_t end = text.find(',', begin);
@@ -199,7 +212,7 @@ PhantomBundle PhantomGenerator::generate(uint64_t index, std::vector<float>& xyz
     size_t b = 0;
     while (b + 1 < kPhantomBundleCount && pick >= cumulative_weights_[b]) ++b;
     bundle = PhantomBundle(b);
-    fiberControls(bundle, rng, buffers.controls);
+    fiberControls(bundle, rng, options_.bundle_radius_scale, buffers.controls);
     // Trackers seed anywhere and run both ways, so either end may come first.
     if (rng.next() & 1) std::reverse(buffers.controls.begin(), buffers.controls.end());
     buildGuide(buffers.controls, kGuideSpacingMm, buffers.guide);

@@ -42,8 +42,13 @@ enum class PhantomBundle : uint8_t {
   IlfLeft,
   IlfRight,
   UFibers,
+  // Fibers throughout the white matter, outside the named bundles (see
+  // phantom_anatomy.cpp): left-right, front-back and bottom-top families.
+  WhiteMatterCommissural,
+  WhiteMatterAssociation,
+  WhiteMatterProjection,
 };
-inline constexpr size_t kPhantomBundleCount = 12;
+inline constexpr size_t kPhantomBundleCount = 15;
 
 inline constexpr unsigned kPhantomMaxRetries = 16;
 
@@ -82,10 +87,22 @@ struct PhantomOptions {
   // Relative share of fibers per bundle (kPhantomBundleCount values >= 0,
   // not all 0), indexed by PhantomBundle; empty = defaultPhantomBundleWeights().
   std::vector<double> bundle_weights;
+  // Cross sections of the named bundles (all but the cingulum) are the
+  // anatomy table's radii times this.
+  double bundle_radius_scale = 1.0;
 };
+
+// The whole-brain mix: the white-matter families (wm_*) at 2.1, 2.1 and 1.8
+// beside the named bundles' default weights (87 % of the fibers), and
+// bundles 2.5 times as thick, so the phantom fills and occludes like
+// whole-brain tracking (MRtrix3 iFOD1 on scripts/make_tckgen_250mb.sh's
+// field: docs/BENCHMARKS.md, "Phantom density"). Sets bundle_weights and
+// bundle_radius_scale of `options`.
+void applyWholeBrainPhantomMix(PhantomOptions& options);
 
 // Throws Error ("phantom: <option> ...", one line) when an option is out of
 // range: step_mm outside [0.005, 10], max_angle_deg outside [1, 90],
+// bundle_radius_scale outside [0.25, 4],
 // min_length_mm outside [0, 150] (no phantom bundle is longer than about
 // 170 mm), max_length_mm below min_length_mm or above 10000, no whole number
 // of steps between the two lengths, jitter outside [0, 4], threads above 1024,
@@ -96,7 +113,8 @@ void validatePhantomOptions(const PhantomOptions& options);
 // vector: named bundles take the given weights, the others keep their
 // default weights. Throws Error naming the bad entry for unknown names,
 // missing '=', or weights that are not finite numbers >= 0.
-std::vector<double> parsePhantomBundleMix(const std::string& text);
+// `base` (kPhantomBundleCount weights) replaces the defaults when given.
+std::vector<double> parsePhantomBundleMix(const std::string& text, const std::vector<double>& base = {});
 
 // Reusable per-thread buffers of PhantomGenerator::generate, so that
 // generation does not allocate per streamline once they have grown.

@@ -7,6 +7,7 @@
 // tractogram - a corpus callosum fanning to both hemispheres, corticospinal
 // tracts fanning from the brainstem to the motor strip, the arcuate's C
 // around the Sylvian fissure - with the statistics of tracker output.
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -33,7 +34,12 @@ void diskPoint(Rng& rng, double& u, double& v) {
 // polyline; `reference` must never be parallel to that direction (each
 // bundle passes an axis its centreline never runs along). One (u, v) per
 // fiber: the fiber keeps its place in the bundle's cross section.
-void offsetCrossSection(std::vector<Vec3>& controls, const double* radius, double u, double v, Vec3 reference) {
+// `scale` multiplies the radii (PhantomOptions::bundle_radius_scale): tracked
+// bundles are fat (a tracker's streamlines of one bundle spread over 1-2 cm
+// of white matter, not a 5 mm cable), and how thick they are decides how
+// much they occlude.
+void offsetCrossSection(std::vector<Vec3>& controls, const double* radius, double u, double v, Vec3 reference,
+                        double scale) {
   const size_t n = controls.size();
   std::array<Vec3, 16> moved;
   for (size_t j = 0; j < n; ++j) {
@@ -41,7 +47,10 @@ void offsetCrossSection(std::vector<Vec3>& controls, const double* radius, doubl
     const Vec3 t = glm::normalize(ahead - behind);
     const Vec3 nrm = glm::normalize(glm::cross(t, reference));
     const Vec3 bin = glm::cross(t, nrm);
-    moved[j] = controls[j] + radius[j] * (u * nrm + v * bin);
+    moved[j] = controls[j] + scale * radius[j] * (u * nrm + v * bin);
+    // Fatter bundles can push end controls past the cortex: pulled back to
+    // relative radius 0.99 (at scale 1 the phantom stays what it always was).
+    if (scale > 1.0 && relativeRadius(moved[j]) > 0.99) moved[j] = atRelativeRadius(moved[j], 0.99);
   }
   for (size_t j = 0; j < n; ++j) controls[j] = moved[j];
 }
@@ -51,11 +60,11 @@ void offsetCrossSection(std::vector<Vec3>& controls, const double* radius, doubl
 // (y = -38), then fanning in each hemisphere from lateral to superior
 // cortex; genu fibers bend forward (forceps minor), splenium fibers backward
 // (forceps major).
-void corpusCallosum(Rng& rng, std::vector<Vec3>& q) {
+void corpusCallosum(Rng& rng, double scale, std::vector<Vec3>& q) {
   const double y0 = rng.uniform(-38.0, 34.0);
   const double arch = (y0 + 2.0) / 36.0;
   const double zc = 10.0 + 12.0 * (1.0 - arch * arch);
-  const double thickness = 3.0 + 1.5 * smoothstep(-24.0, -36.0, y0);  // splenium is the thickest part
+  const double thickness = scale * (3.0 + 1.5 * smoothstep(-24.0, -36.0, y0));  // splenium is the thickest part
   const double dz = thickness * rng.uniform(-1.0, 1.0);
   const double forward = 1.2 * smoothstep(16.0, 34.0, y0) - 1.5 * smoothstep(-20.0, -38.0, y0);
   const double elevation = rng.uniform(10.0, 75.0);
@@ -79,7 +88,7 @@ void corpusCallosum(Rng& rng, std::vector<Vec3>& q) {
 // the posterior limb of the internal capsule, fanning in the corona radiata
 // to the precentral gyrus from the vertex (leg) to the lateral surface
 // (face).
-void corticospinal(Rng& rng, double s, std::vector<Vec3>& q) {
+void corticospinal(Rng& rng, double s, double scale, std::vector<Vec3>& q) {
   const double fan = rng.uniform();
   const double psi = radians(lerp(82.0, 22.0, fan) + rng.uniform(-4.0, 4.0));
   const Vec3 origin = {s * (12.0 + 10.0 * fan), -18.0, 24.0};
@@ -89,14 +98,14 @@ void corticospinal(Rng& rng, double s, std::vector<Vec3>& q) {
   static constexpr double kRadius[] = {2.0, 2.5, 3.0, 3.5, 4.0, 3.0};
   double u, v;
   diskPoint(rng, u, v);
-  offsetCrossSection(q, kRadius, u, v, {0.0, 1.0, 0.0});
+  offsetCrossSection(q, kRadius, u, v, {0.0, 1.0, 0.0}, scale);
 }
 
 // Arcuate fasciculus: the C around the Sylvian fissure, from the inferior
 // frontal and precentral cortex back through the parietal white matter,
 // down around the fissure's posterior end into the temporal lobe; both ends
 // fan over a few centimetres of cortex.
-void arcuate(Rng& rng, double s, std::vector<Vec3>& q) {
+void arcuate(Rng& rng, double s, double scale, std::vector<Vec3>& q) {
   const double frontal = rng.uniform(), temporal = rng.uniform();
   const Vec3 front_origin = {s * 34.0, 10.0 + 14.0 * frontal, 16.0 + 8.0 * (frontal - 0.5)};
   const Vec3 front_end = shellPoint(front_origin, glm::normalize(Vec3{s * 1.0, 0.35 + 0.3 * frontal, 0.05}), corticalDepth(rng));
@@ -112,7 +121,7 @@ void arcuate(Rng& rng, double s, std::vector<Vec3>& q) {
   static constexpr double kRadius[] = {3.0, 3.5, 3.5, 3.5, 3.5, 3.5, 3.0};
   double u, v;
   diskPoint(rng, u, v);
-  offsetCrossSection(q, kRadius, u, v, {1.0, 0.0, 0.0});
+  offsetCrossSection(q, kRadius, u, v, {1.0, 0.0, 0.0}, scale);
 }
 
 // Cingulum: above the corpus callosum from the subgenual cortex, around the
@@ -125,13 +134,13 @@ void cingulum(Rng& rng, double s, std::vector<Vec3>& q) {
   static constexpr double kRadius[] = {2.0, 2.5, 2.5, 2.5, 2.5, 2.5, 2.5, 2.5, 2.0};
   double u, v;
   diskPoint(rng, u, v);
-  offsetCrossSection(q, kRadius, u, v, {1.0, 0.0, 0.0});
+  offsetCrossSection(q, kRadius, u, v, {1.0, 0.0, 0.0}, 1.0);
 }
 
 // Inferior fronto-occipital fasciculus: occipital pole, along the lateral
 // ventricle's wall, through the temporal stem and extreme capsule, into the
 // inferior and orbital frontal cortex.
-void ifof(Rng& rng, double s, std::vector<Vec3>& q) {
+void ifof(Rng& rng, double s, double scale, std::vector<Vec3>& q) {
   const double occipital = rng.uniform(), frontal = rng.uniform();
   const Vec3 back = shellPoint({s * 26.0, -58.0, 4.0 + 12.0 * (occipital - 0.5)}, glm::normalize(Vec3{s * 0.25, -1.0, 0.05}),
                                corticalDepth(rng));
@@ -142,12 +151,12 @@ void ifof(Rng& rng, double s, std::vector<Vec3>& q) {
   static constexpr double kRadius[] = {3.0, 3.5, 3.0, 2.5, 3.0, 3.5};
   double u, v;
   diskPoint(rng, u, v);
-  offsetCrossSection(q, kRadius, u, v, {0.0, 0.0, 1.0});
+  offsetCrossSection(q, kRadius, u, v, {0.0, 0.0, 1.0}, scale);
 }
 
 // Inferior longitudinal fasciculus: occipital cortex to the anterior
 // temporal lobe, below and lateral to the IFOF.
-void ilf(Rng& rng, double s, std::vector<Vec3>& q) {
+void ilf(Rng& rng, double s, double scale, std::vector<Vec3>& q) {
   const double occipital = rng.uniform();
   const Vec3 back = shellPoint({s * 32.0, -56.0, -2.0 + 10.0 * (occipital - 0.5)},
                                glm::normalize(Vec3{s * 0.35, -1.0, -0.1}), corticalDepth(rng));
@@ -156,7 +165,7 @@ void ilf(Rng& rng, double s, std::vector<Vec3>& q) {
   static constexpr double kRadius[] = {3.5, 3.5, 3.0, 3.0, 3.0};
   double u, v;
   diskPoint(rng, u, v);
-  offsetCrossSection(q, kRadius, u, v, {0.0, 0.0, 1.0});
+  offsetCrossSection(q, kRadius, u, v, {0.0, 0.0, 1.0}, scale);
 }
 
 // U-fibers: short arcs connecting neighbouring gyri, 1-2 mm under the
@@ -177,6 +186,114 @@ void uFiber(Rng& rng, std::vector<Vec3>& q) {
     const Vec3 towards = surface_centre + (a * half_span) * site.tangent + offset * across;
     q.push_back(atRelativeRadius(towards, bottom + (top - bottom) * a * a));
   }
+}
+
+// White matter at large: besides the named bundles, whole-brain tracking
+// fills the white matter with fibers in every region, crossing each other,
+// a few per cubic millimetre (MRtrix3 iFOD1 seeded in a brain mask: most
+// 1 mm voxels of the brain hold 1-4 fibers of a 20 k tractogram, where the
+// named bundles alone pack the same fibers into a fifth of the volume at
+// several times the density, and so occlude far more). Three families of
+// fibers seeded uniformly in the deep white matter follow smooth fields of
+// the three kinds of white-matter fibers, the same fields
+// scripts/make_tckgen_250mb.sh gives tckgen to track (so the phantom and a
+// real tracker's output of the same field can be compared):
+//   commissural: circles around an anterior-posterior axis 40 mm below the
+//     centre: left-right across the midline, arching down at the sides;
+//   association: circles around a left-right axis 60 mm below the centre:
+//     front to back, arching down at both ends;
+//   projection: rays from a point 100 mm below the centre: brainstem to the
+//     cortex, fanning.
+// A seed is kept with the family's weight at its place (the tckgen field's
+// lobe amplitudes), so commissural fibers are densest near the midline's
+// plane y = 0, association fibers laterally, projection fibers in two
+// lateral columns.
+enum class WhiteMatterFamily { Commissural, Association, Projection };
+
+double familyWeight(WhiteMatterFamily family, Vec3 p) {
+  switch (family) {
+    case WhiteMatterFamily::Commissural: return std::exp(-(p.y / 55.0) * (p.y / 55.0));
+    case WhiteMatterFamily::Association: return std::clamp(std::abs(p.x) / 40.0, 0.35, 1.0);
+    case WhiteMatterFamily::Projection: {
+      const double d = (std::abs(p.x) - 25.0) / 15.0;
+      return 0.3 + 0.7 * std::exp(-d * d);
+    }
+  }
+  return 1.0;
+}
+
+// The family's curve through `seed` at parameter t (t = 0 at the seed; arc
+// length in mm).
+struct FamilyCurve {
+  WhiteMatterFamily family;
+  Vec3 centre{}, seed{};
+  double radius = 0, angle = 0;  // circles: radius (mm) and angle of the seed
+  Vec3 direction{};              // rays: unit direction
+
+  Vec3 at(double t) const {
+    if (family == WhiteMatterFamily::Projection) return seed + t * direction;
+    const double a = angle + t / radius;
+    if (family == WhiteMatterFamily::Commissural)
+      return centre + radius * Vec3{std::sin(a), 0.0, std::cos(a)};
+    return centre + radius * Vec3{0.0, std::sin(a), std::cos(a)};
+  }
+};
+
+constexpr double kWhiteMatterSeedDepth = 0.85;  // seeds within 85 % of the radius: deep white matter
+constexpr double kWhiteMatterMinRadiusMm = 20.0;  // smaller circles would loop inside the brain
+
+FamilyCurve familyCurve(WhiteMatterFamily family, Vec3 seed) {
+  FamilyCurve c{family};
+  c.seed = seed;
+  switch (family) {
+    case WhiteMatterFamily::Commissural:
+      c.centre = {0.0, seed.y, -40.0};
+      c.radius = std::hypot(seed.x - c.centre.x, seed.z - c.centre.z);
+      c.angle = std::atan2(seed.x - c.centre.x, seed.z - c.centre.z);
+      break;
+    case WhiteMatterFamily::Association:
+      c.centre = {seed.x, 0.0, -60.0};
+      c.radius = std::hypot(seed.y - c.centre.y, seed.z - c.centre.z);
+      c.angle = std::atan2(seed.y - c.centre.y, seed.z - c.centre.z);
+      break;
+    case WhiteMatterFamily::Projection:
+      c.direction = glm::normalize(seed - Vec3{0.0, -10.0, -100.0});
+      break;
+  }
+  return c;
+}
+
+void whiteMatter(Rng& rng, WhiteMatterFamily family, std::vector<Vec3>& q) {
+  // Rejection sampling of the seed: uniform in the deep white matter, kept
+  // with the family's weight (>= 0.3 everywhere, so a few draws suffice).
+  Vec3 seed{0.0, 0.0, 20.0};
+  for (int draw = 0; draw < 256; ++draw) {
+    const Vec3 p = {rng.uniform(-1.0, 1.0) * kPhantomSemiAxesMm[0], rng.uniform(-1.0, 1.0) * kPhantomSemiAxesMm[1],
+                    rng.uniform(-1.0, 1.0) * kPhantomSemiAxesMm[2]};
+    if (relativeRadius(p) > kWhiteMatterSeedDepth) continue;
+    if (family != WhiteMatterFamily::Projection && familyCurve(family, p).radius < kWhiteMatterMinRadiusMm) continue;
+    if (rng.uniform() >= familyWeight(family, p)) continue;
+    seed = p;
+    break;
+  }
+  const FamilyCurve curve = familyCurve(family, seed);
+  // Walk both ways from the seed until the cortex (each end at its own
+  // cortical depth), at most half a circle each way.
+  constexpr double kStepMm = 2.0;
+  constexpr int kControlEvery = 5;  // a control point every 10 mm
+  const double max_t = family == WhiteMatterFamily::Projection ? 400.0 : 0.5 * kPi * curve.radius;
+  double end_t[2] = {0.0, 0.0};
+  for (int side = 0; side < 2; ++side) {
+    const double depth = corticalDepth(rng), sign = side == 0 ? -1.0 : 1.0;
+    double t = 0.0;
+    while (t + kStepMm <= max_t && relativeRadius(curve.at(sign * (t + kStepMm))) <= depth) t += kStepMm;
+    end_t[side] = sign * t;
+  }
+  q.clear();
+  const int steps = int(std::lround((end_t[1] - end_t[0]) / kStepMm));
+  for (int k = 0; k <= steps; ++k)
+    if (k % kControlEvery == 0 || k == steps) q.push_back(curve.at(end_t[0] + kStepMm * k));
+  if (q.size() < 2) q = {seed, curve.at(1.0)};  // a seed at the cortex: a stub the caller redraws
 }
 
 }  // namespace
@@ -206,20 +323,23 @@ const std::vector<UFiberSite>& uFiberSites() {
   return sites;
 }
 
-void fiberControls(PhantomBundle bundle, Rng& rng, std::vector<Vec3>& controls) {
+void fiberControls(PhantomBundle bundle, Rng& rng, double scale, std::vector<Vec3>& controls) {
   switch (bundle) {
-    case PhantomBundle::CorpusCallosum: return corpusCallosum(rng, controls);
-    case PhantomBundle::CstLeft: return corticospinal(rng, -1.0, controls);
-    case PhantomBundle::CstRight: return corticospinal(rng, 1.0, controls);
-    case PhantomBundle::ArcuateLeft: return arcuate(rng, -1.0, controls);
-    case PhantomBundle::ArcuateRight: return arcuate(rng, 1.0, controls);
+    case PhantomBundle::CorpusCallosum: return corpusCallosum(rng, scale, controls);
+    case PhantomBundle::CstLeft: return corticospinal(rng, -1.0, scale, controls);
+    case PhantomBundle::CstRight: return corticospinal(rng, 1.0, scale, controls);
+    case PhantomBundle::ArcuateLeft: return arcuate(rng, -1.0, scale, controls);
+    case PhantomBundle::ArcuateRight: return arcuate(rng, 1.0, scale, controls);
     case PhantomBundle::CingulumLeft: return cingulum(rng, -1.0, controls);
     case PhantomBundle::CingulumRight: return cingulum(rng, 1.0, controls);
-    case PhantomBundle::IfofLeft: return ifof(rng, -1.0, controls);
-    case PhantomBundle::IfofRight: return ifof(rng, 1.0, controls);
-    case PhantomBundle::IlfLeft: return ilf(rng, -1.0, controls);
-    case PhantomBundle::IlfRight: return ilf(rng, 1.0, controls);
+    case PhantomBundle::IfofLeft: return ifof(rng, -1.0, scale, controls);
+    case PhantomBundle::IfofRight: return ifof(rng, 1.0, scale, controls);
+    case PhantomBundle::IlfLeft: return ilf(rng, -1.0, scale, controls);
+    case PhantomBundle::IlfRight: return ilf(rng, 1.0, scale, controls);
     case PhantomBundle::UFibers: return uFiber(rng, controls);
+    case PhantomBundle::WhiteMatterCommissural: return whiteMatter(rng, WhiteMatterFamily::Commissural, controls);
+    case PhantomBundle::WhiteMatterAssociation: return whiteMatter(rng, WhiteMatterFamily::Association, controls);
+    case PhantomBundle::WhiteMatterProjection: return whiteMatter(rng, WhiteMatterFamily::Projection, controls);
   }
 }
 
@@ -228,6 +348,9 @@ double fullSpanProbability(PhantomBundle bundle) {
     case PhantomBundle::UFibers: return 1.0;  // already short; cut further they would fall under min length
     case PhantomBundle::CingulumLeft:
     case PhantomBundle::CingulumRight: return 0.3;  // long and thin: most streamlines cover part of it
+    case PhantomBundle::WhiteMatterCommissural:
+    case PhantomBundle::WhiteMatterAssociation:
+    case PhantomBundle::WhiteMatterProjection: return 1.0;
     default: return 0.5;
   }
 }

@@ -177,7 +177,8 @@ const std::vector<UFiberSite>& uFiberSites();
 // control points of its guide curve (cortex to cortex, or brainstem to
 // cortex), in a canonical order (the caller may reverse it). Every control
 // point lies inside the ellipsoid, at relative radius 0.99 or less.
-void fiberControls(PhantomBundle bundle, Rng& rng, std::vector<Vec3>& controls);
+// `radius_scale` multiplies the bundles' cross-section radii.
+void fiberControls(PhantomBundle bundle, Rng& rng, double radius_scale, std::vector<Vec3>& controls);
 
 // Probability that a fiber of `bundle` covers its whole guide rather than a
 // random part of it (tracking stops early in real data: low FOD amplitude,

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "io/fiber_density.h"
 #include "phantom/phantom.h"
 #include "phantom/phantom_stats.h"
 
@@ -278,6 +279,10 @@ TEST(Phantom, everyBundleIsPresentAndOnItsSide) {
   }
   for (size_t b = 0; b < kPhantomBundleCount; ++b) {
     SCOPED_TRACE(std::string(phantomBundleNames()[b]));
+    if (defaultPhantomBundleWeights()[b] == 0) {
+      EXPECT_EQ(count[b], 0u);  // the white-matter families: only in the whole-brain mix
+      continue;
+    }
     EXPECT_GT(count[b], 40u);
     EXPECT_EQ(wrong_side[b], 0u);
   }
@@ -285,6 +290,57 @@ TEST(Phantom, everyBundleIsPresentAndOnItsSide) {
   const size_t cc = size_t(PhantomBundle::CorpusCallosum);
   EXPECT_GT(crossing[cc], count[cc] / 2);
   EXPECT_EQ(crossing[size_t(PhantomBundle::CstLeft)], 0u);
+}
+
+// The whole-brain mix fills the brain as whole-brain tracking does: its
+// white-matter families spread thinly over most of the volume, where the
+// named bundles pack as many fibers into a fraction of it; fatter bundles
+// stay on their side; each family runs along its own axis.
+TEST(Phantom, wholeBrainMixFillsTheBrainAlongTheFamiliesAxes) {
+  PhantomOptions whole = smallOptions(3000);
+  applyWholeBrainPhantomMix(whole);
+  const Tractogram all = readPhantom(whole);
+  FiberDensityAccumulator spread(2.0), packed(2.0);
+  spread.add(all);
+  packed.add(readPhantom(smallOptions(3000)));
+  const FiberDensity d = spread.result(), b = packed.result();
+  EXPECT_GT(d.occupied_cm3, 2.0 * b.occupied_cm3);
+  EXPECT_LT(d.mean, 0.5 * b.mean);
+  // Most of the brain's volume holds some fiber (the ellipsoid is 1496 cm3).
+  EXPECT_GT(d.occupied_cm3, 0.55 * 4.0 / 3.0 * 3.14159265 * 70 * 85 * 60 / 1000);
+
+  const size_t first_family = size_t(PhantomBundle::WhiteMatterCommissural);
+  double sums[3][3] = {};
+  std::vector<size_t> count(kPhantomBundleCount, 0);
+  for (size_t s = 0; s < all.streamlineCount(); ++s) {
+    const size_t bundle = size_t(all.per_streamline[0].values[s]);
+    ++count[bundle];
+    const std::string_view name = phantomBundleNames()[bundle];
+    float lo = 1e9f, hi = -1e9f;
+    for (size_t k = all.offsets[s]; k < all.offsets[s + 1]; ++k) {
+      lo = std::min(lo, all.point(k)[0]);
+      hi = std::max(hi, all.point(k)[0]);
+    }
+    EXPECT_FALSE(name.ends_with("_left") && hi > 0) << name;
+    EXPECT_FALSE(name.ends_with("_right") && lo < 0) << name;
+    if (bundle < first_family) continue;
+    // Mean |direction| per family: commissural fibers run left-right (x)
+    // where they cross the midline, association fibers front-back (y),
+    // projection fibers bottom-top (z).
+    const size_t family = bundle - first_family;
+    for (size_t k = all.offsets[s] + 1; k < all.offsets[s + 1]; ++k) {
+      const float* p = all.point(k - 1);
+      const float* q = all.point(k);
+      if (family == 0 && std::abs(p[0]) > 10) continue;
+      for (int c = 0; c < 3; ++c) sums[family][c] += std::abs(double(q[c]) - p[c]);
+    }
+  }
+  for (size_t family = 0; family < 3; ++family) {
+    SCOPED_TRACE("family " + std::to_string(family));
+    EXPECT_GT(count[first_family + family], 600u);  // 30 % each of 3000 (weights 2.1, 2.1, 1.8 of 6.9)
+    for (size_t c = 0; c < 3; ++c)
+      if (c != family) EXPECT_GT(sums[family][family], 1.5 * sums[family][c]);
+  }
 }
 
 TEST(Phantom, bundleWeightsSelectTheMix) {
