@@ -1,0 +1,38 @@
+// Bundling, smoothing (shared/bundling.h; FiberVisualizer section 7):
+// one invocation per sample blends it with the mean of the samples of its
+// fiber within k of it (the window cut at the fiber's ends),
+//   p' = (1 - phi) p + phi mean(p_j, max(s0, i - k) <= j <= min(s1 - 1, i + k)),
+// k = round(L / step) (bundling/bundle_setup.h). With anchor_ends the end
+// samples stay.
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_buffer_reference : require
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+
+#include "shared/workgroup.h"
+layout(local_size_x_id = WORKGROUP_SIZE_X_ID) in;  // kBundleGroupSize
+
+#include "glsl/bundling.glsl"
+
+layout(push_constant, std430) uniform Push { BundleSamplePush pc; };
+
+void main() {
+  const uint i = bundleInvocation();
+  if (i >= pc.sample_count) return;
+  BundleVec4Ref src = BundleVec4Ref(pc.src);
+  const vec4 p = src.values[i];
+  const uint fiber = BundleUintsRef(pc.sample_fiber).values[i];
+  const uint s0 = BundleUintsRef(pc.sample_offsets).values[fiber];
+  const uint s1 = BundleUintsRef(pc.sample_offsets).values[fiber + 1u];
+  vec4 result = p;
+  const bool end = i == s0 || i + 1u == s1;
+  if (!(end && pc.anchor_ends != 0u)) {
+    const uint lo = i - min(pc.window, i - s0);
+    const uint hi = min(i + pc.window, s1 - 1u);
+    vec3 sum = vec3(0.0);
+    for (uint j = lo; j <= hi; ++j) sum += src.values[j].xyz;
+    const vec3 mean = sum / float(hi - lo + 1u);
+    result = vec4(p.xyz * (1.0 - pc.step) + mean * pc.step, p.w);
+  }
+  BundleVec4Ref(pc.dst).values[i] = result;
+}
