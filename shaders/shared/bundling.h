@@ -9,6 +9,13 @@
 //             k(dx) k(dy) k(dz), not the radial 1 - |d|^2 / R^2 (which is
 //             not separable). src/bundling/bundle_reference.h's direct 3-D
 //             convolution uses the same product kernel.
+//   splat     (anisotropic mode, instead of count and density) per sample:
+//             adds K(q) = 1 - (q.d)^2 / Ra^2 - |q - d (q.d)|^2 / Rb^2 (>= 0)
+//             at every voxel centre q (voxels from the sample) to the
+//             density, d the fiber's direction at the sample, Ra = R along
+//             it, Rb = anisotropy R across (an ellipsoid elongated along
+//             the fiber); fixed point (kBundleSplatScale per unit) so the
+//             integer atomics keep bundling deterministic
 //   gradient  per voxel: central differences of the density (one-sided at
 //             the grid's faces), world units
 //   advect    per sample: p += R h (g - d (d . g)) / |g| with g the
@@ -37,6 +44,8 @@ BUNDLE_CONST uint kBundleGroupSize = 64u;  // invocations per workgroup of every
 // A gradient shorter than this (density per mm) does not move its sample:
 // its direction is noise.
 BUNDLE_CONST float kBundleMinGradient = 1e-12f;
+// Splatted density units per kernel unit (the splat's integer atomics).
+BUNDLE_CONST float kBundleSplatScale = 256.0f;
 
 // The voxel grid, as every pass sees it (32 bytes).
 struct BundleGridBlock {
@@ -76,6 +85,8 @@ struct BundleSamplePush {
   float step;               // advect: R h (mm); smooth: phi; relax: alpha
   uint window;              // smooth: k
   uint anchor_ends;         // 1: the first and last sample of a fiber stay
+  float radius_along;       // splat: Ra (voxels)
+  float radius_across;      // splat: Rb (voxels)
 };
 
 // Density along one axis and gradient (one invocation per voxel).
@@ -87,16 +98,18 @@ struct BundleGridPush {
   uint src_is_count;  // 1: src holds uint counts
   float radius;       // R in voxels
   float inv_radius2;  // 1 / R^2
+  float src_scale;    // gradient: src_is_count's uint values times this
+  uint pad0;
 };
 
 #ifdef __cplusplus
 static_assert(sizeof(BundleGridBlock) == 32);
 static_assert(sizeof(BundleFiberPush) == 64);
 static_assert(offsetof(BundleFiberPush, fiber_count) == 48);
-static_assert(sizeof(BundleSamplePush) == 88);
+static_assert(sizeof(BundleSamplePush) == 96);
 static_assert(offsetof(BundleSamplePush, src) == 32);
 static_assert(offsetof(BundleSamplePush, sample_count) == 72);
-static_assert(sizeof(BundleGridPush) == 64);
+static_assert(sizeof(BundleGridPush) == 72);
 static_assert(offsetof(BundleGridPush, axis) == 48);
 #endif
 
@@ -106,6 +119,19 @@ SHADER_FN float bundleKernelWeight(float d, float inv_radius2) {
   SHADER_PRECISE float d2 = d * d;
   SHADER_PRECISE float w = 1.0f - d2 * inv_radius2;
   return max(w, 0.0f);
+}
+
+// The anisotropic splat's kernel at offset q (voxels) from a sample whose
+// fiber runs along unit d (0: isotropic with Rb), times kBundleSplatScale
+// and rounded: the integer the splat adds.
+SHADER_FN uint bundleSplatWeight(vec3 q, vec3 d, float inv_along2, float inv_across2) {
+  SHADER_PRECISE float a = (q.x * d.x + q.y * d.y) + q.z * d.z;
+  SHADER_PRECISE float q2 = (q.x * q.x + q.y * q.y) + q.z * q.z;
+  SHADER_PRECISE float b2 = max(q2 - a * a, 0.0f);
+  SHADER_PRECISE float k = (1.0f - a * a * inv_along2) - b2 * inv_across2;
+  if (!(k > 0.0f)) return 0u;
+  SHADER_PRECISE float scaled = k * kBundleSplatScale + 0.5f;
+  return uint(floor(scaled));
 }
 
 SHADER_NAMESPACE_END

@@ -31,7 +31,7 @@ std::string bundleParamsProblem(const BundleParams& p) {
   if (!(p.smoothing_length >= 0 && p.smoothing_length <= 100))
     return outOfRange("smoothing length", p.smoothing_length, "0 to 100 radii");
   if (!(p.relaxation >= 0 && p.relaxation <= 1)) return outOfRange("relaxation", p.relaxation, "in [0, 1]");
-  if (p.mode == BundleMode::Anisotropic) return "bundling: the anisotropic mode is not implemented yet";
+  if (!(p.anisotropy >= 0.05 && p.anisotropy <= 1)) return outOfRange("anisotropy", p.anisotropy, "in [0.05, 1]");
   return "";
 }
 

@@ -11,7 +11,7 @@ namespace fibscope {
 
 enum class BundleMode : uint8_t {
   Isotropic,    // the paper's density: every sample splats the same kernel
-  Anisotropic,  // structure-aware (Bouma, Hurter, Telea): not implemented yet
+  Anisotropic,  // structure-aware (after Bouma, Hurter, Telea): a kernel elongated along each sample's fiber
 };
 
 struct BundleParams {
@@ -28,6 +28,7 @@ struct BundleParams {
   double smoothing_length = 1.0;  // L as a multiple of R (the paper: L = R)
   double relaxation = 0.85;       // alpha: 1 keeps the bundled positions, 0 the original ones
   bool anchor_ends = false;       // true: fiber end points do not move
+  double anisotropy = 0.5;        // anisotropic mode: the kernel's radius across the fiber / along it
 };
 
 // "" when the parameters are usable, else one line naming the parameter,

@@ -107,6 +107,40 @@ std::vector<double> densityDirectReference(const std::vector<double>& counts, co
   return out;
 }
 
+namespace {
+
+glm::dvec3 fiberDirection(const BundleSamples& samples, size_t i, size_t s0, size_t s1) {
+  const glm::dvec3 along = samples[std::min(i + 1, s1 - 1)] - samples[i > s0 ? i - 1 : i];
+  const double len = glm::length(along);
+  return len > 0 ? along / len : glm::dvec3(0.0);
+}
+
+}  // namespace
+
+std::vector<double> splatReference(const BundleSamples& samples, const std::vector<uint32_t>& offsets,
+                                   const BundleGrid& g, double ra, double rb, bool quantise) {
+  std::vector<double> out(g.voxelCount(), 0.0);
+  const glm::dvec3 top = glm::dvec3(g.size) - 1.0;
+  for (size_t i = 0; i < samples.size(); ++i) {
+    const uint32_t f = sampleFiber(offsets, i);
+    const glm::dvec3 d = fiberDirection(samples, i, offsets[f], offsets[f + 1]);
+    const glm::dvec3 c = (samples[i] - g.origin) / g.voxel;
+    const glm::uvec3 lo(glm::clamp(glm::floor(c - ra), glm::dvec3(0.0), top));
+    const glm::uvec3 hi(glm::clamp(glm::floor(c + ra), glm::dvec3(0.0), top));
+    for (uint32_t z = lo.z; z <= hi.z; ++z)
+      for (uint32_t y = lo.y; y <= hi.y; ++y)
+        for (uint32_t x = lo.x; x <= hi.x; ++x) {
+          const glm::dvec3 q = glm::dvec3(x, y, z) + 0.5 - c;
+          const double a = glm::dot(q, d), b2 = std::max(glm::dot(q, q) - a * a, 0.0);
+          const double k = 1 - a * a / (ra * ra) - b2 / (rb * rb);
+          if (!(k > 0)) continue;
+          const double s = double(shader::kBundleSplatScale);
+          out[g.index(x, y, z)] += quantise ? std::floor(k * s + 0.5) / s : k;
+        }
+  }
+  return out;
+}
+
 std::vector<glm::dvec3> gradientReference(const std::vector<double>& density, const BundleGrid& g) {
   std::vector<glm::dvec3> out(density.size());
   const uint64_t strides[3] = {1, g.size.x, uint64_t(g.size.x) * g.size.y};
@@ -212,7 +246,10 @@ std::vector<float> mapBackReference(const Tractogram& t, const BundleSetup& setu
 BundleSamples iterateReference(const BundleSamples& samples, const BundleSetup& setup, const BundleParams& params,
                                double radius) {
   const BundleGrid& grid = setup.grid;
-  const std::vector<double> density = densitySeparableReference(countReference(samples, grid), grid, radius);
+  const std::vector<double> density =
+      params.mode == BundleMode::Anisotropic
+          ? splatReference(samples, setup.sample_offsets, grid, radius, radius * params.anisotropy)
+          : densitySeparableReference(countReference(samples, grid), grid, radius);
   const std::vector<glm::dvec3> gradient = gradientReference(density, grid);
   const BundleSamples advected =
       advectReference(samples, setup.sample_offsets, gradient, grid, bundleAdvectionStep(params, setup, radius),

@@ -36,6 +36,15 @@ std::vector<double> densitySeparableReference(const std::vector<double>& counts,
 // |dz| <= floor(R) (mathematically equal to the separable passes).
 std::vector<double> densityDirectReference(const std::vector<double>& counts, const BundleGrid& grid, double radius);
 
+// Anisotropic splat: at every voxel centre within Ra (voxels, per axis) of
+// each sample, the kernel max(0, 1 - a^2 / Ra^2 - b^2 / Rb^2) with a and b
+// the offset's parts along and across the sample's fiber direction (the
+// advection's), summed in double; `quantise`: each term rounded to
+// 1 / kBundleSplatScale as the GPU's fixed point.
+std::vector<double> splatReference(const BundleSamples& samples, const std::vector<uint32_t>& sample_offsets,
+                                   const BundleGrid& grid, double radius_along, double radius_across,
+                                   bool quantise = true);
+
 // Gradient: central differences / 2h, one-sided / h at the faces (world units).
 std::vector<glm::dvec3> gradientReference(const std::vector<double>& density, const BundleGrid& grid);
 // The gradient at p, trilinear between voxel centres (clamped at the faces).

@@ -290,4 +290,57 @@ TEST(Bundling, referenceRunPullsNeighbouringFibersTogether) {
   EXPECT_EQ(bundleReference(t, p), out);  // deterministic
 }
 
+TEST(Bundling, anisotropicSplatIsAnEllipsoidAlongTheFiber) {
+  const BundleGrid g = smallGrid({21, 21, 21}, 1.0);
+  // One fiber along x through the centre of voxel (10, 10, 10).
+  const glm::dvec3 c = g.origin + glm::dvec3(10.5);
+  const BundleSamples s = {c - glm::dvec3(1, 0, 0), c, c + glm::dvec3(1, 0, 0)};
+  const std::vector<uint32_t> offsets = {0, 3};
+  const double ra = 6, rb = 3;
+  // A fiber of one sample has no direction: isotropic with Rb.
+  const std::vector<double> d = splatReference({s[1]}, {0, 1}, g, ra, rb, false);
+  EXPECT_DOUBLE_EQ(d[g.index(10, 10, 10)], 1.0);
+  EXPECT_DOUBLE_EQ(d[g.index(11, 10, 10)], 1 - 1 / (rb * rb));
+  const std::vector<double> e = splatReference(s, offsets, g, ra, rb, false);
+  // The middle sample alone at offsets along and across the fiber (the
+  // other two add theirs: compare the difference of two splats).
+  const std::vector<double> ends = splatReference({s[0], s[2]}, {0, 2}, g, ra, rb, false);
+  auto mid = [&](uint32_t x, uint32_t y, uint32_t z) { return e[g.index(x, y, z)] - ends[g.index(x, y, z)]; };
+  EXPECT_NEAR(mid(14, 10, 10), 1 - 16 / (ra * ra), 1e-12);  // 4 along
+  EXPECT_NEAR(mid(10, 12, 10), 1 - 4 / (rb * rb), 1e-12);   // 2 across
+  EXPECT_NEAR(mid(10, 10, 13), 0.0, 1e-12);                 // 3 across: the rim
+  EXPECT_NEAR(mid(13, 11, 10), 1 - 9 / (ra * ra) - 1 / (rb * rb), 1e-12);
+  // Fixed point: each term rounded to 1/256.
+  const std::vector<double> q = splatReference(s, offsets, g, ra, rb, true);
+  for (size_t i = 0; i < q.size(); ++i) {
+    ASSERT_NEAR(q[i], e[i], 3 * 0.5 / 256 + 1e-12);
+    ASSERT_EQ(q[i] * 256, std::round(q[i] * 256));
+  }
+}
+
+TEST(Bundling, anisotropicModeKeepsFibersFartherApartThanTheIsotropic) {
+  // Two parallel fibers 3 mm apart: the isotropic kernel (4 mm) pulls them
+  // together, the anisotropic one (2 mm across) barely.
+  Tractogram t;
+  std::vector<float> a, b;
+  for (int i = 0; i <= 20; ++i) {
+    a.insert(a.end(), {float(i), 0, 0});
+    b.insert(b.end(), {float(i), 3, 0});
+  }
+  t.addStreamline(a.data(), 21);
+  t.addStreamline(b.data(), 21);
+  BundleParams p;
+  p.voxel_mm = 0.5;
+  p.step_mm = 1;
+  p.radius = 8;
+  p.iterations = 2;
+  p.advection = 0.25;
+  const std::vector<float> iso = bundleReference(t, p);
+  p.mode = BundleMode::Anisotropic;
+  const std::vector<float> aniso = bundleReference(t, p);
+  const float iso_gap = iso[3 * 31 + 1] - iso[3 * 10 + 1], aniso_gap = aniso[3 * 31 + 1] - aniso[3 * 10 + 1];
+  EXPECT_LT(iso_gap, 2.0f);
+  EXPECT_GT(aniso_gap, 2.5f);
+}
+
 }  // namespace fibscope

@@ -186,4 +186,32 @@ TEST_F(GpuBundling, anchoredEndsStayWhereTheyWere) {
       for (int k = 0; k < 3; ++k) ASSERT_EQ(a[3 * i + k], model_.positions[3 * i + k]) << f;
 }
 
+TEST_F(GpuBundling, anisotropicSplatAndIterationMatchTheReference) {
+  params_.mode = BundleMode::Anisotropic;
+  GpuBundler bundler(context());
+  bundler.load(model_, setup_, params_);
+  const BundleSamples original = toDouble(bundler.originalSamples());
+  bundler.iterate(params_.radius);
+  const std::vector<uint32_t> fixed = bundler.counts();
+  const std::vector<double> cpu =
+      splatReference(original, setup_.sample_offsets, setup_.grid, params_.radius, params_.radius * params_.anisotropy);
+  double scale = 0;
+  for (double v : cpu) scale = std::max(scale, v);
+  ASSERT_GT(scale, 2);
+  double worst = 0;
+  for (size_t i = 0; i < cpu.size(); ++i)
+    worst = std::max(worst, std::abs(double(fixed[i]) / shader::kBundleSplatScale - cpu[i]));
+  // Float against double can round a term the other way: 1/256 each, rarely.
+  EXPECT_LT(worst, 4.0 / shader::kBundleSplatScale);
+  const BundleSamples expect = iterateReference(original, setup_, params_, params_.radius);
+  const std::vector<glm::vec4> gpu = bundler.samples();
+  double mean_err = 0, mean_move = 0;
+  for (size_t i = 0; i < expect.size(); ++i) {
+    mean_err += glm::length(expect[i] - glm::dvec3(gpu[i])) / double(expect.size());
+    mean_move += glm::length(expect[i] - original[i]) / double(expect.size());
+  }
+  EXPECT_GT(mean_move, 0.2);
+  EXPECT_LT(mean_err, 1e-3 * mean_move + 1e-4);
+}
+
 }  // namespace fibscope

@@ -35,6 +35,7 @@ BundlePipelines createBundlePipelines(const gpu::VulkanContext& context) {
     p.smooth = gpu::createComputePipeline(context, "bundle_smooth.comp", sample, kGroup);
     p.relax = gpu::createComputePipeline(context, "bundle_relax.comp", sample, kGroup);
     p.map_back = gpu::createComputePipeline(context, "bundle_map_back.comp", fiber, kGroup);
+    p.splat = gpu::createComputePipeline(context, "bundle_splat.comp", sample, kGroup);
   } catch (...) {
     destroyBundlePipelines(context, p);
     throw;
@@ -44,7 +45,7 @@ BundlePipelines createBundlePipelines(const gpu::VulkanContext& context) {
 
 void destroyBundlePipelines(const gpu::VulkanContext& context, BundlePipelines& p) {
   for (gpu::ComputePipeline* c : {&p.resample, &p.count, &p.density, &p.gradient, &p.advect, &p.smooth, &p.relax,
-                                  &p.map_back})
+                                  &p.map_back, &p.splat})
     gpu::destroyComputePipeline(context, *c);
 }
 
@@ -67,6 +68,10 @@ void recordBundleAdvect(VkCommandBuffer cmd, const gpu::VulkanContext& context, 
 void recordBundleSmooth(VkCommandBuffer cmd, const gpu::VulkanContext& context, const BundlePipelines& p,
                         const shader::BundleSamplePush& push, gpu::GpuTimer* timer) {
   dispatch(cmd, context, p.smooth, push, push.sample_count, timer, "bundle smooth");
+}
+void recordBundleSplat(VkCommandBuffer cmd, const gpu::VulkanContext& context, const BundlePipelines& p,
+                       const shader::BundleSamplePush& push, gpu::GpuTimer* timer) {
+  dispatch(cmd, context, p.splat, push, push.sample_count, timer, "bundle splat");
 }
 void recordBundleRelax(VkCommandBuffer cmd, const gpu::VulkanContext& context, const BundlePipelines& p,
                        const shader::BundleSamplePush& push, gpu::GpuTimer* timer) {

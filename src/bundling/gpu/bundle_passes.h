@@ -15,7 +15,7 @@
 namespace fibscope {
 
 struct BundlePipelines {
-  gpu::ComputePipeline resample, count, density, gradient, advect, smooth, relax, map_back;
+  gpu::ComputePipeline resample, count, density, gradient, advect, smooth, relax, map_back, splat;
 };
 
 // Throws Error when a pipeline cannot be made (none is left then).
@@ -34,6 +34,8 @@ void recordBundleAdvect(VkCommandBuffer cmd, const gpu::VulkanContext& context, 
                         const shader::BundleSamplePush& push, gpu::GpuTimer* timer);
 void recordBundleSmooth(VkCommandBuffer cmd, const gpu::VulkanContext& context, const BundlePipelines& p,
                         const shader::BundleSamplePush& push, gpu::GpuTimer* timer);
+void recordBundleSplat(VkCommandBuffer cmd, const gpu::VulkanContext& context, const BundlePipelines& p,
+                       const shader::BundleSamplePush& push, gpu::GpuTimer* timer);
 void recordBundleRelax(VkCommandBuffer cmd, const gpu::VulkanContext& context, const BundlePipelines& p,
                        const shader::BundleSamplePush& push, gpu::GpuTimer* timer);
 // Per voxel.

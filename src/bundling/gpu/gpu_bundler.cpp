@@ -126,22 +126,34 @@ void GpuBundler::iterate(double radius) {
     afterEarlierWork(cmd);
     vkCmdFillBuffer(cmd, counts_.buffer, 0, VK_WHOLE_SIZE, 0);
     gpu::recordBarrier(cmd, gpu::kTransferToCompute);
-    shader::BundleSamplePush count = sample;
-    count.src = current_.address;
-    count.field = counts_.address;
-    recordBundleCount(cmd, context_, pipelines_, count, &timer_);
-    const VkDeviceAddress from[3] = {counts_.address, density_.address, density_tmp_.address};
-    const VkDeviceAddress to[3] = {density_.address, density_tmp_.address, density_.address};
-    for (uint32_t axis = 0; axis < 3; ++axis) {
-      shader::BundleGridPush p = dens;
-      p.axis = axis;
-      p.src_is_count = axis == 0 ? 1u : 0u;
-      p.src = from[axis];
-      p.dst = to[axis];
-      recordBundleDensityAxis(cmd, context_, pipelines_, p, &timer_);
-    }
     shader::BundleGridPush g = dens;
-    g.src = density_.address;
+    if (params_.mode == BundleMode::Anisotropic) {
+      shader::BundleSamplePush splat = sample;
+      splat.src = current_.address;
+      splat.field = counts_.address;
+      splat.radius_along = float(radius);
+      splat.radius_across = float(radius * params_.anisotropy);
+      recordBundleSplat(cmd, context_, pipelines_, splat, &timer_);
+      g.src = counts_.address;
+      g.src_is_count = 1;
+      g.src_scale = 1.0f / shader::kBundleSplatScale;
+    } else {
+      shader::BundleSamplePush count = sample;
+      count.src = current_.address;
+      count.field = counts_.address;
+      recordBundleCount(cmd, context_, pipelines_, count, &timer_);
+      const VkDeviceAddress from[3] = {counts_.address, density_.address, density_tmp_.address};
+      const VkDeviceAddress to[3] = {density_.address, density_tmp_.address, density_.address};
+      for (uint32_t axis = 0; axis < 3; ++axis) {
+        shader::BundleGridPush p = dens;
+        p.axis = axis;
+        p.src_is_count = axis == 0 ? 1u : 0u;
+        p.src = from[axis];
+        p.dst = to[axis];
+        recordBundleDensityAxis(cmd, context_, pipelines_, p, &timer_);
+      }
+      g.src = density_.address;
+    }
     g.dst = gradient_.address;
     recordBundleGradient(cmd, context_, pipelines_, g, &timer_);
     shader::BundleSamplePush advect = sample;

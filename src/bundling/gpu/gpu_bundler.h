@@ -48,8 +48,8 @@ class GpuBundler {
   std::vector<glm::vec4> originalSamples() const;
   std::vector<glm::vec4> samples() const;   // current (after smoothing)
   std::vector<glm::vec4> advected() const;  // after the last advection
-  std::vector<uint32_t> counts() const;
-  std::vector<float> density() const;  // after the z pass
+  std::vector<uint32_t> counts() const;  // anisotropic: the splat's fixed-point density
+  std::vector<float> density() const;  // after the z pass (isotropic)
   std::vector<glm::vec4> gradient() const;
 
   uint64_t bytes() const;  // device memory of the loaded model
