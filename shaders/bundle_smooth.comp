@@ -1,9 +1,11 @@
 // Bundling, smoothing (shared/bundling.h; FiberVisualizer section 7):
 // one invocation per sample blends it with the mean of the samples of its
-// fiber within k of it (the window cut at the fiber's ends),
-//   p' = (1 - phi) p + phi mean(p_j, max(s0, i - k) <= j <= min(s1 - 1, i + k)),
-// k = round(L / step) (bundling/bundle_setup.h). With anchor_ends the end
-// samples stay.
+// fiber within m of it,
+//   p' = (1 - phi) p + phi mean(p_j, |j - i| <= m),  m = min(k, i - s0, s1 - 1 - i),
+// k = round(L / step) (bundling/bundle_setup.h): the window stays
+// symmetric near the fiber's ends (a window cut on one side would pull
+// the ends inward, shortening the fiber every iteration), so the end
+// samples themselves move by advection only.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_buffer_reference : require
@@ -27,8 +29,9 @@ void main() {
   vec4 result = p;
   const bool end = i == s0 || i + 1u == s1;
   if (!(end && pc.anchor_ends != 0u)) {
-    const uint lo = i - min(pc.window, i - s0);
-    const uint hi = min(i + pc.window, s1 - 1u);
+    const uint m = min(pc.window, min(i - s0, s1 - 1u - i));
+    const uint lo = i - m;
+    const uint hi = i + m;
     vec3 sum = vec3(0.0);
     for (uint j = lo; j <= hi; ++j) sum += src.values[j].xyz;
     const vec3 mean = sum / float(hi - lo + 1u);

@@ -203,7 +203,8 @@ BundleSamples smoothReference(const BundleSamples& samples, const std::vector<ui
     const uint32_t f = sampleFiber(offsets, i);
     const size_t s0 = offsets[f], s1 = offsets[f + 1];
     if ((i == s0 || i + 1 == s1) && anchor_ends) continue;
-    const size_t lo = i - std::min<size_t>(window, i - s0), hi = std::min<size_t>(i + window, s1 - 1);
+    const size_t m = std::min<size_t>({window, i - s0, s1 - 1 - i});
+    const size_t lo = i - m, hi = i + m;
     glm::dvec3 sum(0.0);
     for (size_t j = lo; j <= hi; ++j) sum += samples[j];
     out[i] = samples[i] * (1 - phi) + sum / double(hi - lo + 1) * phi;

@@ -54,7 +54,8 @@ glm::dvec3 interpolateGradient(const std::vector<glm::dvec3>& gradient, const Bu
 BundleSamples advectReference(const BundleSamples& samples, const std::vector<uint32_t>& sample_offsets,
                               const std::vector<glm::dvec3>& gradient, const BundleGrid& grid, double step_mm,
                               bool anchor_ends);
-// Smoothing: p' = (1 - phi) p + phi mean(p_j, |j - i| <= window, within the fiber).
+// Smoothing: p' = (1 - phi) p + phi mean(p_j, |j - i| <= m), m = min(window,
+// i - s0, s1 - 1 - i): symmetric near the ends, which only advection moves.
 BundleSamples smoothReference(const BundleSamples& samples, const std::vector<uint32_t>& sample_offsets, double phi,
                               uint32_t window, bool anchor_ends);
 // Relaxation: o + alpha (p - o).

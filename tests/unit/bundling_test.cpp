@@ -214,19 +214,23 @@ TEST(Bundling, advectionMovesOrthogonallyToTheFiberByTheStep) {
   EXPECT_NE(anchored[3], s[3]);
 }
 
-TEST(Bundling, smoothingBlendsWithTheWindowMeanCutAtTheEnds) {
+TEST(Bundling, smoothingBlendsWithASymmetricWindowMean) {
   const BundleSamples s = {{0, 0, 0}, {1, 2, 0}, {2, 0, 0}, {3, 4, 0}, {4, 0, 1}};
   const std::vector<uint32_t> offsets = {0, 5};
   const BundleSamples out = smoothReference(s, offsets, 0.9, 1, false);
   const glm::dvec3 mean2 = (s[1] + s[2] + s[3]) / 3.0;
   EXPECT_NEAR(glm::length(out[2] - (0.1 * s[2] + 0.9 * mean2)), 0, 1e-12);
-  const glm::dvec3 mean0 = (s[0] + s[1]) / 2.0;  // window cut at the start
-  EXPECT_NEAR(glm::length(out[0] - (0.1 * s[0] + 0.9 * mean0)), 0, 1e-12);
-  const BundleSamples wide = smoothReference(s, offsets, 0.5, 2, true);
-  EXPECT_EQ(wide[0], s[0]);
-  EXPECT_EQ(wide[4], s[4]);
-  const glm::dvec3 mean1 = (s[0] + s[1] + s[2] + s[3]) / 4.0;
+  EXPECT_EQ(out[0], s[0]);  // an end: no window that stays symmetric
+  EXPECT_EQ(out[4], s[4]);
+  const BundleSamples wide = smoothReference(s, offsets, 0.5, 2, false);
+  const glm::dvec3 mean1 = (s[0] + s[1] + s[2]) / 3.0;  // window 2 shrunk to 1 next to the end
   EXPECT_NEAR(glm::length(wide[1] - (0.5 * s[1] + 0.5 * mean1)), 0, 1e-12);
+  const glm::dvec3 mean_all = (s[0] + s[1] + s[2] + s[3] + s[4]) / 5.0;
+  EXPECT_NEAR(glm::length(wide[2] - (0.5 * s[2] + 0.5 * mean_all)), 0, 1e-12);
+  // A straight, evenly sampled fiber does not shrink.
+  const BundleSamples straight = line(glm::dvec3(1, 2, 3), glm::dvec3(0, 0.6, 0.8), 9, 1.5);
+  const BundleSamples kept = smoothReference(straight, {0, 9}, 0.9, 3, false);
+  for (size_t i = 0; i < straight.size(); ++i) EXPECT_NEAR(glm::length(kept[i] - straight[i]), 0, 1e-12) << i;
 }
 
 TEST(Bundling, relaxationInterpolatesTowardsTheOriginals) {
