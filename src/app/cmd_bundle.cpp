@@ -91,9 +91,8 @@ void addBundleCommand(CLI::App& app) {
     const bool fbl = isFblPath(opt->output);
     if (!fbl) {
       // The writer's own extension check, before the long part.
-      const std::string ext = opt->output.substr(opt->output.find_last_of('.') == std::string::npos
-                                                     ? opt->output.size()
-                                                     : opt->output.find_last_of('.'));
+      const std::string ext = opt->output.substr(
+          opt->output.find_last_of('.') == std::string::npos ? opt->output.size() : opt->output.find_last_of('.'));
       if (ext != ".tck" && ext != ".trk" && ext != ".trx")
         fail(opt->output, "unknown output format (use .tck, .trk, .trx or .fbl)");
     }
@@ -129,8 +128,8 @@ void addBundleCommand(CLI::App& app) {
       CompressOptions co;
       co.overwrite = opt->force;
       co.resample = true;  // bundled fibers no longer have a constant step
-      const CompressReport r = compressTractogram(
-          [&] { return std::make_unique<MemoryReader>(bundled, header); }, opt->output, co);
+      const CompressReport r =
+          compressTractogram([&] { return std::make_unique<MemoryReader>(bundled, header); }, opt->output, co);
       for (const auto& w : r.warnings) std::fprintf(stderr, "fibscope: warning: %s\n", w.c_str());
     } else {
       WriterOptions wo;
@@ -140,21 +139,23 @@ void addBundleCommand(CLI::App& app) {
       for (const auto& w : warnings) std::fprintf(stderr, "fibscope: warning: %s\n", w.c_str());
     }
     const BundleDisplacement d = bundleDisplacement(model, bundled.positions);
-    std::printf("wrote %s: %zu fibers, %zu points (%u samples, grid %u x %u x %u of %.4g mm); displacement mean %.3f mm, "
-                "max %.3f mm; %.2f s\n",
-                opt->output.c_str(), bundled.streamlineCount(), bundled.pointCount(), setup.sampleCount(),
-                setup.grid.size.x, setup.grid.size.y, setup.grid.size.z, setup.grid.voxel, d.mean_mm, d.max_mm,
-                seconds);
+    std::printf(
+        "wrote %s: %zu fibers, %zu points (%u samples, grid %u x %u x %u of %.4g mm); displacement mean %.3f mm, "
+        "max %.3f mm; %.2f s\n",
+        opt->output.c_str(), bundled.streamlineCount(), bundled.pointCount(), setup.sampleCount(), setup.grid.size.x,
+        setup.grid.size.y, setup.grid.size.z, setup.grid.voxel, d.mean_mm, d.max_mm, seconds);
     if (!opt->report) return;
     const Camera camera = bundleInkCamera(model);
     const uint64_t ink_before = bundleInk(model, camera), ink_after = bundleInk(bundled, camera);
     std::printf("  device      %s\n", context.info().name.c_str());
-    std::printf("  parameters  mode %s, R %.4g voxels (%.4g mm) x %.4g per iteration, %u iterations, step %.4g mm, "
-                "phi %.3g, L %.3g R, alpha %.3g, advection %.3g R%s\n",
-                bundleModeName(params.mode), params.radius, params.radius * setup.grid.voxel, params.radius_decay,
-                params.iterations, setup.step_mm, params.smoothing, params.smoothing_length, params.relaxation,
-                params.advection, params.anchor_ends ? ", ends anchored" : "");
-    if (params.mode == BundleMode::Anisotropic) std::printf("  anisotropy  %.3g (kernel radius across / along)\n", params.anisotropy);
+    std::printf(
+        "  parameters  mode %s, R %.4g voxels (%.4g mm) x %.4g per iteration, %u iterations, step %.4g mm, "
+        "phi %.3g, L %.3g R, alpha %.3g, advection %.3g R%s\n",
+        bundleModeName(params.mode), params.radius, params.radius * setup.grid.voxel, params.radius_decay,
+        params.iterations, setup.step_mm, params.smoothing, params.smoothing_length, params.relaxation,
+        params.advection, params.anchor_ends ? ", ends anchored" : "");
+    if (params.mode == BundleMode::Anisotropic)
+      std::printf("  anisotropy  %.3g (kernel radius across / along)\n", params.anisotropy);
     std::printf("  ink         %llu -> %llu px (%.1f%%) in a %u x %u coronal view\n",
                 static_cast<unsigned long long>(ink_before), static_cast<unsigned long long>(ink_after),
                 ink_before ? 100.0 * double(ink_after) / double(ink_before) : 0.0, camera.width, camera.height);

@@ -22,7 +22,8 @@ std::string bundleParamsProblem(const BundleParams& p) {
   if (!(p.radius >= 1 && p.radius <= 256)) return outOfRange("radius", p.radius, "1 to 256 voxels");
   if (!(p.radius_decay > 0 && p.radius_decay <= 1)) return outOfRange("radius decay", p.radius_decay, "in (0, 1]");
   if (!(p.advection > 0 && p.advection <= 4)) return outOfRange("advection", p.advection, "in (0, 4] radii");
-  if (!(p.voxel_mm >= 0 && std::isfinite(p.voxel_mm))) return outOfRange("voxel", p.voxel_mm, "0 (automatic) or more mm");
+  if (!(p.voxel_mm >= 0 && std::isfinite(p.voxel_mm)))
+    return outOfRange("voxel", p.voxel_mm, "0 (automatic) or more mm");
   if (!(p.voxel_fraction > 0 && p.voxel_fraction <= 1))
     return outOfRange("voxel fraction", p.voxel_fraction, "in (0, 1]");
   if (!(p.step_mm >= 0 && std::isfinite(p.step_mm))) return outOfRange("step", p.step_mm, "0 (automatic) or more mm");

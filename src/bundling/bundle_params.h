@@ -17,12 +17,12 @@ enum class BundleMode : uint8_t {
 struct BundleParams {
   BundleMode mode = BundleMode::Isotropic;
   uint32_t iterations = 15;
-  double radius = 10;           // kernel radius R (voxels) of the first iteration
-  double radius_decay = 0.95;   // R is multiplied by this after each iteration
-  double advection = 1.0;       // advection step as a multiple of R (the paper: R)
-  double voxel_mm = 0;          // 0: voxel_fraction of the box's largest side
+  double radius = 10;          // kernel radius R (voxels) of the first iteration
+  double radius_decay = 0.95;  // R is multiplied by this after each iteration
+  double advection = 1.0;      // advection step as a multiple of R (the paper: R)
+  double voxel_mm = 0;         // 0: voxel_fraction of the box's largest side
   double voxel_fraction = 0.003;
-  double step_mm = 0;           // resampling interval; 0: step_fraction of the box's z extent
+  double step_mm = 0;  // resampling interval; 0: step_fraction of the box's z extent
   double step_fraction = 0.01;
   double smoothing = 0.9;         // phi: weight of the neighbours' mean
   double smoothing_length = 1.0;  // L as a multiple of R (the paper: L = R)

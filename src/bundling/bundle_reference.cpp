@@ -62,8 +62,7 @@ std::vector<double> countReference(const BundleSamples& samples, const BundleGri
   return counts;
 }
 
-std::vector<double> convolveAxisReference(const std::vector<double>& in, const BundleGrid& g, int axis,
-                                          double radius) {
+std::vector<double> convolveAxisReference(const std::vector<double>& in, const BundleGrid& g, int axis, double radius) {
   std::vector<double> out(in.size(), 0.0);
   const int r = int(std::floor(radius));
   const int n = int(g.size[axis]);
@@ -75,13 +74,15 @@ std::vector<double> convolveAxisReference(const std::vector<double>& in, const B
         const int at = int(glm::uvec3(x, y, z)[axis]);
         double sum = 0;
         for (int d = std::max(-r, -at); d <= std::min(r, n - 1 - at); ++d)
-          sum += std::max(0.0, 1.0 - double(d) * d / (radius * radius)) * in[uint64_t(int64_t(index) + d * int64_t(stride))];
+          sum += std::max(0.0, 1.0 - double(d) * d / (radius * radius)) *
+                 in[uint64_t(int64_t(index) + d * int64_t(stride))];
         out[index] = sum;
       }
   return out;
 }
 
-std::vector<double> densitySeparableReference(const std::vector<double>& counts, const BundleGrid& grid, double radius) {
+std::vector<double> densitySeparableReference(const std::vector<double>& counts, const BundleGrid& grid,
+                                              double radius) {
   return convolveAxisReference(convolveAxisReference(convolveAxisReference(counts, grid, 0, radius), grid, 1, radius),
                                grid, 2, radius);
 }
@@ -252,11 +253,10 @@ BundleSamples iterateReference(const BundleSamples& samples, const BundleSetup& 
           ? splatReference(samples, setup.sample_offsets, grid, radius, radius * params.anisotropy)
           : densitySeparableReference(countReference(samples, grid), grid, radius);
   const std::vector<glm::dvec3> gradient = gradientReference(density, grid);
-  const BundleSamples advected =
-      advectReference(samples, setup.sample_offsets, gradient, grid, bundleAdvectionStep(params, setup, radius),
-                      params.anchor_ends);
-  return smoothReference(advected, setup.sample_offsets, params.smoothing,
-                         bundleSmoothingWindow(params, setup, radius), params.anchor_ends);
+  const BundleSamples advected = advectReference(samples, setup.sample_offsets, gradient, grid,
+                                                 bundleAdvectionStep(params, setup, radius), params.anchor_ends);
+  return smoothReference(advected, setup.sample_offsets, params.smoothing, bundleSmoothingWindow(params, setup, radius),
+                         params.anchor_ends);
 }
 
 std::vector<float> bundleReference(const Tractogram& t, const BundleParams& params) {

@@ -25,8 +25,8 @@ struct BundleGrid {
 
 struct BundleSetup {
   BundleGrid grid;
-  double step_mm = 0;                     // the resampling interval asked for (a fiber's is len / (n - 1) <= it)
-  std::vector<uint32_t> sample_offsets;   // fiber f's samples: [sample_offsets[f], sample_offsets[f + 1])
+  double step_mm = 0;                    // the resampling interval asked for (a fiber's is len / (n - 1) <= it)
+  std::vector<uint32_t> sample_offsets;  // fiber f's samples: [sample_offsets[f], sample_offsets[f + 1])
   uint32_t sampleCount() const { return sample_offsets.back(); }
 };
 

@@ -125,7 +125,8 @@ TEST(Bundling, resamplingPlacesEqualIntervalsAndKeepsTheEnds) {
   const double spacing = 7.5 / 8;
   for (size_t i = 1; i < r.size(); ++i) {
     // Along the polyline: on the same segment the chord is the arc.
-    const bool same_segment = (i * spacing <= 3 || (i - 1) * spacing >= 3) && (i * spacing <= 7 || (i - 1) * spacing >= 7);
+    const bool same_segment =
+        (i * spacing <= 3 || (i - 1) * spacing >= 3) && (i * spacing <= 7 || (i - 1) * spacing >= 7);
     if (same_segment) {
       EXPECT_NEAR(glm::length(r[i] - r[i - 1]), spacing, 1e-12) << i;
     }
@@ -143,7 +144,8 @@ TEST(Bundling, separableDensityEqualsTheDirectProductKernelConvolution) {
     const std::vector<double> direct = densityDirectReference(counts, g, radius);
     const double scale = maxAbs(direct);
     ASSERT_GT(scale, 1);
-    for (size_t i = 0; i < counts.size(); ++i) ASSERT_NEAR(separable[i], direct[i], 1e-12 * scale) << radius << " " << i;
+    for (size_t i = 0; i < counts.size(); ++i)
+      ASSERT_NEAR(separable[i], direct[i], 1e-12 * scale) << radius << " " << i;
   }
 }
 
@@ -182,8 +184,8 @@ TEST(Bundling, gradientIsExactOnALinearDensity) {
   const glm::dvec3 c = g.origin + g.voxel * glm::dvec3(2.5, 2.5, 1.5);
   EXPECT_NEAR(glm::length(interpolateGradient(grad, g, c) - grad[g.index(2, 2, 1)]), 0, 1e-12);
   const glm::dvec3 h = g.origin + g.voxel * glm::dvec3(3.0, 2.5, 1.5);
-  EXPECT_NEAR(glm::length(interpolateGradient(grad, g, h) - (grad[g.index(2, 2, 1)] + grad[g.index(3, 2, 1)]) * 0.5),
-              0, 1e-12);
+  EXPECT_NEAR(glm::length(interpolateGradient(grad, g, h) - (grad[g.index(2, 2, 1)] + grad[g.index(3, 2, 1)]) * 0.5), 0,
+              1e-12);
 }
 
 TEST(Bundling, advectionMovesOrthogonallyToTheFiberByTheStep) {
@@ -259,7 +261,7 @@ TEST(Bundling, mapBackKeepsThePointsAndInterpolatesTheDisplacement) {
   ASSERT_EQ(m.size(), t.positions.size());
   auto at = [&](int i) { return glm::dvec3(m[3 * i], m[3 * i + 1], m[3 * i + 2]); };
   EXPECT_NEAR(glm::length(at(0) - glm::dvec3(0, 1, 0)), 0, 1e-6);
-  EXPECT_NEAR(glm::length(at(1) - glm::dvec3(1, 2, 0)), 0, 1e-6);       // halfway between samples 0 and 1
+  EXPECT_NEAR(glm::length(at(1) - glm::dvec3(1, 2, 0)), 0, 1e-6);         // halfway between samples 0 and 1
   EXPECT_NEAR(glm::length(at(2) - glm::dvec3(2.5, 2.25, 0.5)), 0, 1e-6);  // a quarter from sample 1 to 2
   EXPECT_NEAR(glm::length(at(3) - glm::dvec3(4, 0, 2)), 0, 1e-6);
   // No displacement: the points come back as they were.

@@ -154,8 +154,8 @@ TEST_F(GpuBundling, bundlingTwiceGivesBitIdenticalPointsWithTheSameOffsets) {
   std::vector<gpu::PassTime> times;
   uint64_t bytes = 0;
   uint32_t reported = 0;
-  const std::vector<float> a = bundleOnGpu(context(), model_, params_, [&](uint32_t done) { reported = done; }, &times,
-                                           &bytes);
+  const std::vector<float> a = bundleOnGpu(
+      context(), model_, params_, [&](uint32_t done) { reported = done; }, &times, &bytes);
   const std::vector<float> b = bundleOnGpu(context(), model_, params_);
   ASSERT_EQ(a.size(), model_.positions.size());
   ASSERT_EQ(b.size(), a.size());

@@ -32,7 +32,8 @@ TEST(GpuCliBundle, bundledPhantomKeepsItsFibersAndMovesItsPoints) {
   test::TempDir dir;
   auto r = test::runFibscope("phantom " + dir.file("in.tck") + " --streamlines 200 --seed 2");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  r = test::runFibscope("bundle " + dir.file("in.tck") + " " + dir.file("out.trk") + kSmall + " --iterations 3 --report");
+  r = test::runFibscope("bundle " + dir.file("in.tck") + " " + dir.file("out.trk") + kSmall +
+                        " --iterations 3 --report");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   if (r.output.find("no usable Vulkan device") != std::string::npos) GTEST_SKIP() << r.output;
   EXPECT_NE(r.output.find("displacement mean"), std::string::npos) << r.output;

@@ -44,8 +44,8 @@ BundlePipelines createBundlePipelines(const gpu::VulkanContext& context) {
 }
 
 void destroyBundlePipelines(const gpu::VulkanContext& context, BundlePipelines& p) {
-  for (gpu::ComputePipeline* c : {&p.resample, &p.count, &p.density, &p.gradient, &p.advect, &p.smooth, &p.relax,
-                                  &p.map_back, &p.splat})
+  for (gpu::ComputePipeline* c :
+       {&p.resample, &p.count, &p.density, &p.gradient, &p.advect, &p.smooth, &p.relax, &p.map_back, &p.splat})
     gpu::destroyComputePipeline(context, *c);
 }
 

@@ -211,7 +211,9 @@ void GpuBundler::addTimes() {
 std::vector<glm::vec4> GpuBundler::originalSamples() const {
   return download<glm::vec4>(context_, original_, setup_.sampleCount());
 }
-std::vector<glm::vec4> GpuBundler::samples() const { return download<glm::vec4>(context_, current_, setup_.sampleCount()); }
+std::vector<glm::vec4> GpuBundler::samples() const {
+  return download<glm::vec4>(context_, current_, setup_.sampleCount());
+}
 std::vector<glm::vec4> GpuBundler::advected() const {
   return download<glm::vec4>(context_, scratch_, setup_.sampleCount());
 }

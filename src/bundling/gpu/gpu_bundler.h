@@ -48,8 +48,8 @@ class GpuBundler {
   std::vector<glm::vec4> originalSamples() const;
   std::vector<glm::vec4> samples() const;   // current (after smoothing)
   std::vector<glm::vec4> advected() const;  // after the last advection
-  std::vector<uint32_t> counts() const;  // anisotropic: the splat's fixed-point density
-  std::vector<float> density() const;  // after the z pass (isotropic)
+  std::vector<uint32_t> counts() const;     // anisotropic: the splat's fixed-point density
+  std::vector<float> density() const;       // after the z pass (isotropic)
   std::vector<glm::vec4> gradient() const;
 
   uint64_t bytes() const;  // device memory of the loaded model
@@ -74,8 +74,7 @@ class GpuBundler {
 // A whole run on the GPU: planBundling, load, params.iterations iterations
 // (`progress` called after each with the iterations done), finish.
 std::vector<float> bundleOnGpu(const gpu::VulkanContext& context, const Tractogram& tractogram,
-                               const BundleParams& params,
-                               const std::function<void(uint32_t done)>& progress = {},
+                               const BundleParams& params, const std::function<void(uint32_t done)>& progress = {},
                                std::vector<gpu::PassTime>* times = nullptr, uint64_t* device_bytes = nullptr);
 
 }  // namespace fibscope
