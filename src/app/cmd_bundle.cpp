@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <string>
 
+#include "app/bundle_output.h"
 #include "app/commands.h"
 #include "app/open_input.h"
 #include "bundling/bundle_params.h"
@@ -23,32 +24,6 @@
 #include "io/writer.h"
 
 namespace fibscope {
-
-namespace {
-
-// The bundled model handed to the compressor in one chunk (it reads its
-// input twice: the factory makes a fresh reader each time).
-class MemoryReader final : public TractogramReader {
- public:
-  MemoryReader(const Tractogram& tractogram, const TractogramHeader& header) : tractogram_(tractogram) {
-    header_ = header;
-    header_.declared_streamlines = int64_t(tractogram.streamlineCount());
-    header_.declared_points = int64_t(tractogram.pointCount());
-  }
-  bool read(Tractogram& chunk, size_t) override {
-    if (done_) return false;
-    chunk = tractogram_;
-    done_ = true;
-    return true;
-  }
-  uint64_t bytesRead() const override { return 0; }
-
- private:
-  const Tractogram& tractogram_;
-  bool done_ = false;
-};
-
-}  // namespace
 
 void addBundleCommand(CLI::App& app) {
   struct Options {
@@ -88,14 +63,7 @@ void addBundleCommand(CLI::App& app) {
     params.mode = parseBundleMode(opt->mode);
     validateBundleParams(params);
     checkOverwrite(opt->output, opt->force);
-    const bool fbl = isFblPath(opt->output);
-    if (!fbl) {
-      // The writer's own extension check, before the long part.
-      const std::string ext = opt->output.substr(
-          opt->output.find_last_of('.') == std::string::npos ? opt->output.size() : opt->output.find_last_of('.'));
-      if (ext != ".tck" && ext != ".trk" && ext != ".trx")
-        fail(opt->output, "unknown output format (use .tck, .trk, .trx or .fbl)");
-    }
+    checkBundledOutputPath(opt->output);  // the writer's own extension check, before the long part
 
     const auto start = std::chrono::steady_clock::now();
     auto reader = openInput(opt->input);
@@ -124,20 +92,8 @@ void addBundleCommand(CLI::App& app) {
     progress.finish();
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
-    if (fbl) {
-      CompressOptions co;
-      co.overwrite = opt->force;
-      co.resample = true;  // bundled fibers no longer have a constant step
-      const CompressReport r =
-          compressTractogram([&] { return std::make_unique<MemoryReader>(bundled, header); }, opt->output, co);
-      for (const auto& w : r.warnings) std::fprintf(stderr, "fibscope: warning: %s\n", w.c_str());
-    } else {
-      WriterOptions wo;
-      wo.overwrite = opt->force;
-      std::vector<std::string> warnings;
-      writeTractogram(opt->output, bundled, header, wo, &warnings);
-      for (const auto& w : warnings) std::fprintf(stderr, "fibscope: warning: %s\n", w.c_str());
-    }
+    for (const auto& w : writeBundledTractogram(opt->output, bundled, header, opt->force))
+      std::fprintf(stderr, "fibscope: warning: %s\n", w.c_str());
     const BundleDisplacement d = bundleDisplacement(model, bundled.positions);
     std::printf(
         "wrote %s: %zu fibers, %zu points (%u samples, grid %u x %u x %u of %.4g mm); displacement mean %.3f mm, "
