@@ -6,6 +6,7 @@
 // commands are tested without a GPU.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cstdlib>
 #include <string>
 
@@ -122,6 +123,21 @@ TEST_F(GpuViewerBundling, bundlesWhileFramesGoOnTogglesSavesAndReopens) {
   const auto again = runViewer("--offscreen --size 160x120 --frames 2 --screenshot " + reopened + " " + saved);
   ASSERT_EQ(again.exit_code, 0) << again.output;
   EXPECT_GT(test::readOurPng(reopened).width, 0u);
+}
+
+TEST_F(GpuViewerBundling, quittingWhileBundlingCancelsTheJobAndLeavesNoFiles) {
+  const std::string script = dir_.file("s.txt"), tmp = dir_.file("tmp");
+  test::writeBytes(script, "wait-loaded\nbundle radius=4 iterations=1000 voxel=2\nwait 3\nquit\n");
+  const auto start = std::chrono::steady_clock::now();
+  const auto r = test::runCommand("mkdir -p '" + tmp + "' && TMPDIR='" + tmp + "' FIBSCOPE_CACHE_DIR='" + dir_.path() +
+                                  "' " + FIBSCOPE_EXE +
+                                  " view --validate --offscreen --size 64x64 --phantom-streamlines 300 --script " + script);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output.find("fibscope view: bundled "), std::string::npos) << r.output;
+  EXPECT_LT(seconds, 60.0) << "1000 iterations were not run to the end";
+  const auto left = test::runCommand("find '" + tmp + "' -type f | wc -l");
+  EXPECT_EQ(std::atoi(left.output.c_str()), 0) << left.output;
 }
 
 TEST_F(GpuViewerBundling, aSaveToAnExistingFileOrWithoutAModelIsAMessage) {

@@ -247,6 +247,7 @@ class ViewerApp {
   uint64_t bundle_first_frame_ = 0;  // frames_drawn_ when the job started
   uint64_t bundle_frames_ = 0;       // frames drawn while the job ran
   std::optional<ViewerBundleResult> bundle_result_;
+  std::vector<std::pair<uint64_t, std::string>> bundled_exact_;  // a bundled model's id, its exact .tck
   std::string recent_files_path_;
   uint64_t frames_drawn_ = 0;
 
@@ -1007,6 +1008,7 @@ void ViewerApp::pollBundling() {
       return;
     }
     if (!done) return;
+    for (const std::string& w : done->warnings) std::fprintf(stderr, "fibscope view: warning: %s\n", w.c_str());
     bundle_frames_ = frames_drawn_ - bundle_first_frame_;
     bundle_result_ = done;
     b.progress = LoadingInfo{};
@@ -1026,6 +1028,7 @@ void ViewerApp::bundledModelAdded() {
   b.running = false;
   const int added = int(state_.models.size()) - 1;  // addModel made it the active one
   b.bundled_model = added;
+  bundled_exact_.emplace_back(scenes_[size_t(added)]->id, bundle_result_->exact_path);
   b.source_model = -1;
   for (size_t i = 0; i < scenes_.size(); ++i) {
     if (scenes_[i]->id == bundle_source_id_) {
@@ -1052,8 +1055,13 @@ void ViewerApp::saveModel(const SaveModelAction& save) {
       throw Error("save-model " + std::to_string(save.model) + ": no such model (" +
                   std::to_string(scenes_.size()) + " loaded)");
     const ModelData& data = *scenes_[size_t(save.model)]->data;
+    const uint64_t id = scenes_[size_t(save.model)]->id;
+    const auto exact = std::find_if(bundled_exact_.begin(), bundled_exact_.end(),
+                                    [&](const auto& e) { return e.first == id; });
     std::unique_ptr<TractogramReader> reader;
-    if (!data.source_path.empty()) {
+    if (exact != bundled_exact_.end()) {
+      reader = openInput(exact->second);  // the bundled positions, not the fiblets' resampled ones
+    } else if (!data.source_path.empty()) {
       reader = openInput(data.source_path);
     } else if (!data.temporary) {
       reader = openFbl(data.fbl.path());

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <system_error>
 
+#include "app/bundle_output.h"
 #include "app/open_input.h"
 #include "bundling/bundle_quality.h"
 #include "bundling/bundle_setup.h"
@@ -27,7 +28,7 @@ std::string bundledFileName(const std::string& name, uint64_t job) {
   for (char& c : stem)
     if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_')) c = '_';
   if (stem.empty()) stem = "model";
-  return stem + "-bundled-" + std::to_string(job) + ".tck";
+  return stem + "-bundled-" + std::to_string(job);
 }
 
 }  // namespace
@@ -78,7 +79,6 @@ std::optional<ViewerBundleResult> ViewerBundling::poll() {
   if (!error_.empty()) throw Error(error_);
   std::optional<ViewerBundleResult> result = std::move(result_);
   result_.reset();
-  if (result) temp_files_.push_back(result->path);
   return result;
 }
 
@@ -87,7 +87,6 @@ void ViewerBundling::cancel() {
   if (worker_.joinable()) worker_.join();
   std::lock_guard lock(mutex_);
   progress_.reset();
-  if (result_) temp_files_.push_back(result_->path);  // finished meanwhile: removed with the rest
   result_.reset();
   error_.clear();
 }
@@ -155,7 +154,9 @@ void ViewerBundling::run(ViewerBundleSource source, BundleParams params) {
     bundled.positions = std::move(moved);
     ViewerBundleResult result;
     result.model = name;
-    result.path = (std::filesystem::path(temp_dir_) / bundledFileName(name, jobs_)).string();
+    const std::string stem = (std::filesystem::path(temp_dir_) / bundledFileName(name, jobs_)).string();
+    result.exact_path = stem + ".tck";
+    result.path = stem + ".fbl";
     {
       ProgressSnapshot writing;
       writing.label = "writing";
@@ -163,7 +164,20 @@ void ViewerBundling::run(ViewerBundleSource source, BundleParams params) {
     }
     WriterOptions wo;
     wo.overwrite = true;
-    writeTractogram(result.path, bundled, header, wo, nullptr);
+    writeTractogram(result.exact_path, bundled, header, wo, nullptr);
+    {
+      std::lock_guard lock(mutex_);
+      temp_files_.push_back(result.exact_path);
+      temp_files_.push_back(result.path);
+    }
+    stopIfCancelled();
+    ProgressSnapshot compressing;
+    compressing.label = "compressing";
+    report(compressing);
+    // To fiblets here, resampled (bundled fibers have no constant step):
+    // the loader then opens the .fbl as it is.
+    for (const std::string& w : writeBundledTractogram(result.path, bundled, header, /*overwrite=*/true))
+      result.warnings.push_back(w);
     const BundleDisplacement d = bundleDisplacement(model, bundled.positions);
     result.fibers = bundled.streamlineCount();
     result.points = bundled.pointCount();

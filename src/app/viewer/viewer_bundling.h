@@ -6,9 +6,10 @@
 // GpuBundler on a VulkanContext of its own: the viewer's context is used by
 // the main thread only (model_loader.h), and a second context needs no
 // locking of queues shared with the frame loop. The bundled copy is written
-// to a temporary .tck (removed with the ViewerBundling) that the frame loop
-// then opens through the ModelLoader like any file, so it is compressed to
-// fiblets, uploaded and listed like any model.
+// to a temporary .tck (its exact positions, for Save) and compressed to a
+// temporary .fbl (resampled, as `fibscope bundle OUT.fbl`), both removed
+// with the ViewerBundling; the frame loop then opens the .fbl through the
+// ModelLoader, so it is uploaded and listed like any model.
 //
 // Cancel (or the destructor) stops the job at its next iteration and joins
 // the worker; the job's context and buffers are released on the worker.
@@ -38,7 +39,9 @@ struct ViewerBundleSource {
 
 struct ViewerBundleResult {
   std::string model;  // the source model's name
-  std::string path;   // the bundled copy (a temporary .tck)
+  std::string path;        // the bundled copy compressed to fiblets (a temporary .fbl, resampled)
+  std::string exact_path;  // its exact positions (a temporary .tck): what Save writes
+  std::vector<std::string> warnings;
   uint64_t fibers = 0, points = 0;
   double mean_mm = 0, max_mm = 0;  // displacement of the points
   double seconds = 0;

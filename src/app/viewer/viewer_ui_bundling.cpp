@@ -34,24 +34,34 @@ void progressSection(const LoadingInfo& l) {
 }  // namespace
 
 void drawBundlingPanel(ViewerState& state, std::vector<ViewerAction>& actions) {
-  ImGui::SetNextWindowPos(ImVec2(10, 420), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowSize(ImVec2(300, 0), ImGuiCond_FirstUseEver);
-  if (!ImGui::Begin("Bundle", &state.show_bundling)) {
+  // At the right, under the performance overlay, sized to its content.
+  const ImGuiViewport* viewport = ImGui::GetMainViewport();
+  ImGui::SetNextWindowPos(ImVec2(viewport->WorkPos.x + viewport->WorkSize.x - 330, viewport->WorkPos.y + 360),
+                          ImGuiCond_FirstUseEver);
+  if (!ImGui::Begin("Bundle", &state.show_bundling, ImGuiWindowFlags_AlwaysAutoResize)) {
     ImGui::End();
     return;
   }
   BundlingInfo& b = state.bundling;
   BundleParams& p = b.params;
   ImGui::BeginDisabled(b.running);
+  ImGui::SetNextItemWidth(120);
   ImGui::InputDouble("radius R (voxels)", &p.radius, 1, 5, "%.3g");
   int iterations = int(p.iterations);
+  ImGui::SetNextItemWidth(120);
   if (ImGui::InputInt("iterations", &iterations)) p.iterations = uint32_t(std::clamp(iterations, 1, 1000));
+  ImGui::SetNextItemWidth(120);
   ImGui::InputDouble("radius decay", &p.radius_decay, 0.01, 0.05, "%.3g");
+  ImGui::SetNextItemWidth(120);
   ImGui::InputDouble("voxel (mm, 0: auto)", &p.voxel_mm, 0.1, 1, "%.3g");
+  ImGui::SetNextItemWidth(120);
   ImGui::InputDouble("step (mm, 0: auto)", &p.step_mm, 0.1, 1, "%.3g");
+  ImGui::SetNextItemWidth(120);
   ImGui::InputDouble("smoothing phi", &p.smoothing, 0.05, 0.1, "%.3g");
+  ImGui::SetNextItemWidth(120);
   ImGui::InputDouble("relaxation alpha", &p.relaxation, 0.05, 0.1, "%.3g");
   int mode = p.mode == BundleMode::Anisotropic ? 1 : 0;
+  ImGui::SetNextItemWidth(120);
   if (ImGui::Combo("mode", &mode, "isotropic\0anisotropic\0")) p.mode = mode ? BundleMode::Anisotropic : BundleMode::Isotropic;
   if (p.mode == BundleMode::Anisotropic) ImGui::InputDouble("anisotropy", &p.anisotropy, 0.05, 0.1, "%.3g");
   const bool has_model = state.active_model >= 0 && state.active_model < int(state.models.size());
@@ -75,11 +85,16 @@ void drawBundlingPanel(ViewerState& state, std::vector<ViewerAction>& actions) {
     ImGui::EndDisabled();
     ImGui::SameLine();
     if (ImGui::RadioButton("bundled", shown == 1)) actions.push_back(ShowOnlyModelAction{b.bundled_model});
+    ImGui::SetNextItemWidth(160);
     ImGui::InputText("##save", &b.save_path);
     ImGui::SameLine();
     if (ImGui::Button("Save bundled...")) actions.push_back(SaveModelAction{b.bundled_model, b.save_path});
   }
-  if (!b.message.empty()) ImGui::TextWrapped("%s", b.message.c_str());
+  if (!b.message.empty()) {
+    ImGui::PushTextWrapPos(ImGui::GetCursorPosX() + 300);
+    ImGui::TextUnformatted(b.message.c_str());
+    ImGui::PopTextWrapPos();
+  }
   ImGui::End();
 }
 
