@@ -19,5 +19,6 @@ void addGpuInfoCommand(CLI::App& app);
 void addRenderCommand(CLI::App& app);
 void addBenchCommand(CLI::App& app);
 void addViewCommand(CLI::App& app);
+void addBundleCommand(CLI::App& app);
 
 }  // namespace fibscope

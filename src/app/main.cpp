@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   fibscope::addRenderCommand(app);
   fibscope::addBenchCommand(app);
   fibscope::addViewCommand(app);
+  fibscope::addBundleCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -12,6 +12,7 @@
 #include <variant>
 
 #include "app/viewer/dissection.h"
+#include "bundling/bundle_params.h"
 #include "render/camera.h"
 #include "render/render_settings.h"
 
@@ -120,11 +121,32 @@ struct SliceStepAction {
   double voxels = 0;
 };
 
+// Bundling (viewer_bundling.h): the active model bundled on a worker with
+// these parameters; the copy is added as a new model, shown and active, the
+// source hidden. Cancel stops a running job.
+struct BundleAction {
+  BundleParams params;
+};
+struct CancelBundleAction {};
+// Model N shown and active, every other model hidden (the Bundle panel's
+// original / bundled toggle).
+struct ShowOnlyModelAction {
+  int model = -1;
+};
+// Model N's fibers written by PATH's extension as `fibscope bundle` writes
+// (app/bundle_output.h): its source file read again (a bundled copy's is its
+// exact positions), else its .fbl, else the phantom. An existing PATH is refused.
+struct SaveModelAction {
+  int model = -1;
+  std::string path;
+};
+
 using ViewerAction = std::variant<OrbitAction, PanAction, DollyAction, ViewAction, FovAction, SetAction,
                                   ScreenshotAction, OpenAction, CloseModelAction, ModelAction, PickAction, ClearSelectionAction,
                                   ExportSelectionAction, ExpectSelectedAction, DissectionAction, RoiSetFileAction,
                                   ExportKeptAction, ExpectKeptAction, RoiPlaceAction, RoiDragAction, RoiResizeAction,
-                                  ResizeAction, QuitAction, AnatomyAction, SliceStepAction>;
+                                  ResizeAction, QuitAction, AnatomyAction, SliceStepAction, BundleAction,
+                                  CancelBundleAction, ShowOnlyModelAction, SaveModelAction>;
 
 // Sets one RenderSettings field from text, as `set KEY VALUE` in a script:
 // KEY is a setting's name in render/settings_table.h (the command line's

@@ -14,9 +14,11 @@
 #include <thread>
 #include <type_traits>
 
+#include "app/bundle_output.h"
 #include "app/model_loader.h"
 #include "app/open_input.h"
 #include "app/viewer/adaptive_detail.h"
+#include "app/viewer/viewer_bundling.h"
 #include "app/viewer/dissection.h"
 #include "app/viewer/imgui_layer.h"
 #include "app/viewer/orbit_controller.h"
@@ -167,6 +169,12 @@ class ViewerApp {
   void dissect(FrameScene& scene, bool now);
   void applyDissection(const ViewerAction& action);
   void pollExport();
+  // Bundling (viewer_bundling.h): the job's progress -> state_, its result
+  // opened through the loader; the copy once loaded shown and active.
+  void startBundle(const BundleParams& params);
+  void pollBundling();
+  void bundledModelAdded();
+  void saveModel(const SaveModelAction& save);
   // The fiber drawn at window pixel (x, y) of the last frame (no hit when
   // none is drawn there or no frame is).
   PickResult pickDrawn(double x, double y);
@@ -233,6 +241,13 @@ class ViewerApp {
   std::vector<uint64_t> startup_jobs_;
   std::vector<std::pair<uint64_t, uint64_t>> job_first_frame_;  // job id, frames_drawn_ when requested
   std::optional<RawDecode> raw_decode_;
+  std::unique_ptr<ViewerBundling> bundling_;
+  uint64_t bundle_source_id_ = 0;   // the model being bundled (ViewerModel::id)
+  uint64_t bundle_load_job_ = 0;    // the loader's job opening the bundled copy (0: none)
+  uint64_t bundle_first_frame_ = 0;  // frames_drawn_ when the job started
+  uint64_t bundle_frames_ = 0;       // frames drawn while the job ran
+  std::optional<ViewerBundleResult> bundle_result_;
+  std::vector<std::pair<uint64_t, std::string>> bundled_exact_;  // a bundled model's id, its exact .tck
   std::string recent_files_path_;
   uint64_t frames_drawn_ = 0;
 
@@ -332,6 +347,7 @@ void ViewerApp::createFrameObjects() {
   ModelLoaderOptions loader_options;
   loader_options.phantom_streamlines = options_.phantom_streamlines;
   loader_ = std::make_unique<ModelLoader>(loader_options);
+  bundling_ = std::make_unique<ViewerBundling>(options_.device);
   // Loaded on the worker while frames are drawn; a file that cannot be
   // read shows its error (pollLoads; offscreen, one named on the command
   // line ends the run).
@@ -370,6 +386,7 @@ ViewerApp::~ViewerApp() { release(); }
 
 void ViewerApp::release() {
   if (!context_) return;
+  bundling_.reset();  // cancels a bundling job at its next iteration and joins its worker
   loader_.reset();  // cancels the running job and joins the worker
   cancelRawDecode();
   vkDeviceWaitIdle(context_->device());
@@ -428,6 +445,7 @@ void ViewerApp::pollLoads() {
     if (event.ok()) {
       try {
         addModel(event);
+        if (event.id == bundle_load_job_) bundledModelAdded();
         continue;
       } catch (const Error& e) {
         event.error = e.what();  // the upload failed (e.g. it does not fit on the device)
@@ -437,6 +455,11 @@ void ViewerApp::pollLoads() {
     // one opened from the panel is (status line, the models panel's list of
     // failures) and the viewer goes on; without a window nobody would see
     // it, so the run ends with its one-line error (exit 2), as `render`'s.
+    if (event.id == bundle_load_job_) {
+      bundle_load_job_ = 0;
+      state_.bundling.running = false;
+      state_.bundling.message = event.error;
+    }
     if (startup && !window_) throw Error(event.error);
     state_.status = event.error;
     state_.load_failures.push_back(LoadFailure{event.path, event.error});
@@ -542,6 +565,8 @@ void ViewerApp::closeModel(int model) {
   };
   const bool was_active = state_.active_model == model;
   shift(state_.active_model);
+  shift(state_.bundling.source_model);
+  shift(state_.bundling.bundled_model);
   scene_lengths_->invalidate();
   drawn_layout_ = {};  // the G-buffer may show the closed model: no picks until the next frame
   drawn_ids_.clear();
@@ -822,6 +847,26 @@ void ViewerApp::apply(const ViewerAction& action) {
           loadAnatomy(a.path);
         } else if constexpr (std::is_same_v<A, SliceStepAction>) {
           stepActiveSlice(state_, a.voxels);
+        } else if constexpr (std::is_same_v<A, BundleAction>) {
+          startBundle(a.params);
+        } else if constexpr (std::is_same_v<A, CancelBundleAction>) {
+          bundling_->cancel();
+          if (bundle_load_job_) loader_->cancel(bundle_load_job_);
+          bundle_load_job_ = 0;
+          state_.bundling.running = false;
+          state_.bundling.message = "bundling cancelled";
+          state_.status = state_.bundling.message;
+        } else if constexpr (std::is_same_v<A, ShowOnlyModelAction>) {
+          if (a.model < 0 || a.model >= int(state_.models.size())) {
+            state_.status = "show-model " + std::to_string(a.model) + ": no such model (" +
+                            std::to_string(state_.models.size()) + " loaded)";
+            std::fprintf(stderr, "fibscope view: %s\n", state_.status.c_str());
+          } else {
+            for (size_t i = 0; i < state_.models.size(); ++i) state_.models[i].visible = int(i) == a.model;
+            state_.active_model = a.model;
+          }
+        } else if constexpr (std::is_same_v<A, SaveModelAction>) {
+          saveModel(a);
         }
       },
       action);
@@ -910,6 +955,134 @@ void ViewerApp::applyDissection(const ViewerAction& action) {
     if (const auto* edit = std::get_if<DissectionAction>(&action))
       if (std::holds_alternative<CutMeshAddEdit>(edit->edit)) d.cut_mesh_message = e.what();
     report(e.what());
+  }
+}
+
+void ViewerApp::startBundle(const BundleParams& params) {
+  BundlingInfo& b = state_.bundling;
+  const int m = state_.active_model;
+  try {
+    if (m < 0 || m >= int(scenes_.size())) throw Error("bundle: no model to bundle");
+    if (b.running) throw Error("bundle: a bundling job is running");
+    const ModelData& data = *scenes_[size_t(m)]->data;
+    ViewerBundleSource source;
+    source.name = data.name;
+    source.source_path = data.source_path;
+    if (!data.temporary) source.fbl_path = data.fbl.path();
+    source.phantom_streamlines = options_.phantom_streamlines;
+    source.phantom_seed = loader_->options().phantom_seed;  // the loader's phantom, made again
+    bundling_->start(source, params);
+    b.params = params;
+    b.running = true;
+    b.source_model = m;
+    b.bundled_model = -1;
+    b.message.clear();
+    bundle_source_id_ = scenes_[size_t(m)]->id;
+    bundle_first_frame_ = frames_drawn_;
+    state_.status = "bundling " + data.name;
+    std::fprintf(stderr, "fibscope view: bundling %s (%s, R %.4g, %u iterations)\n", data.name.c_str(),
+                 bundleModeName(params.mode), params.radius, params.iterations);
+  } catch (const Error& e) {
+    b.message = e.what();
+    state_.status = e.what();
+    std::fprintf(stderr, "fibscope view: %s\n", e.what());
+  }
+}
+
+void ViewerApp::pollBundling() {
+  BundlingInfo& b = state_.bundling;
+  if (const std::optional<ProgressSnapshot> p = bundling_->progress()) {
+    b.progress.label = p->label;
+    b.progress.unit = p->unit;
+    b.progress.done = p->done;
+    b.progress.total = p->total;
+    b.progress.rate = p->rate;
+    b.progress.eta_seconds = p->eta_seconds;
+    b.progress.elapsed_seconds = p->elapsed_seconds;
+  }
+  if (!bundling_->running()) return;
+  try {
+    const std::optional<ViewerBundleResult> done = bundling_->poll();
+    if (!bundling_->running() && !done) {  // cancelled
+      b.running = false;
+      return;
+    }
+    if (!done) return;
+    for (const std::string& w : done->warnings) std::fprintf(stderr, "fibscope view: warning: %s\n", w.c_str());
+    bundle_frames_ = frames_drawn_ - bundle_first_frame_;
+    bundle_result_ = done;
+    b.progress = LoadingInfo{};
+    b.progress.label = "compressing the bundled copy";
+    bundle_load_job_ = loader_->request(done->path);  // compressed to fiblets like any file
+  } catch (const Error& e) {
+    b.running = false;
+    b.message = e.what();
+    state_.status = e.what();
+    std::fprintf(stderr, "fibscope view: %s\n", e.what());
+  }
+}
+
+void ViewerApp::bundledModelAdded() {
+  BundlingInfo& b = state_.bundling;
+  bundle_load_job_ = 0;
+  b.running = false;
+  const int added = int(state_.models.size()) - 1;  // addModel made it the active one
+  b.bundled_model = added;
+  bundled_exact_.emplace_back(scenes_[size_t(added)]->id, bundle_result_->exact_path);
+  b.source_model = -1;
+  for (size_t i = 0; i < scenes_.size(); ++i) {
+    if (scenes_[i]->id == bundle_source_id_) {
+      b.source_model = int(i);
+      state_.models[i].visible = false;  // the bundled copy shown in its place
+    }
+  }
+  char line[512];
+  const ViewerBundleResult& r = *bundle_result_;
+  std::snprintf(line, sizeof line,
+                "bundled %s: %llu fibers, %llu points, displacement mean %.3f mm, max %.3f mm, %.2f s; "
+                "%llu frames drawn while bundling, %llu progress reports; model %d",
+                r.model.c_str(), static_cast<unsigned long long>(r.fibers), static_cast<unsigned long long>(r.points),
+                r.mean_mm, r.max_mm, r.seconds, static_cast<unsigned long long>(bundle_frames_),
+                static_cast<unsigned long long>(r.progress_reports), added);
+  b.message = line;
+  state_.status = line;
+  std::fprintf(stderr, "fibscope view: %s\n", line);
+}
+
+void ViewerApp::saveModel(const SaveModelAction& save) {
+  try {
+    if (save.model < 0 || save.model >= int(scenes_.size()))
+      throw Error("save-model " + std::to_string(save.model) + ": no such model (" +
+                  std::to_string(scenes_.size()) + " loaded)");
+    const ModelData& data = *scenes_[size_t(save.model)]->data;
+    const uint64_t id = scenes_[size_t(save.model)]->id;
+    const auto exact = std::find_if(bundled_exact_.begin(), bundled_exact_.end(),
+                                    [&](const auto& e) { return e.first == id; });
+    std::unique_ptr<TractogramReader> reader;
+    if (exact != bundled_exact_.end()) {
+      reader = openInput(exact->second);  // the bundled positions, not the fiblets' resampled ones
+    } else if (!data.source_path.empty()) {
+      reader = openInput(data.source_path);
+    } else if (!data.temporary) {
+      reader = openFbl(data.fbl.path());
+    } else {
+      PhantomOptions phantom;
+      phantom.streamlines = options_.phantom_streamlines;
+      phantom.seed = loader_->options().phantom_seed;
+      reader = openPhantom(phantom);
+    }
+    const TractogramHeader header = reader->header();
+    const Tractogram tractogram = readAllStreamlines(*reader);
+    for (const std::string& w : writeBundledTractogram(save.path, tractogram, header, /*overwrite=*/false))
+      std::fprintf(stderr, "fibscope view: warning: %s\n", w.c_str());
+    state_.status = "saved " + data.name + " (" + std::to_string(tractogram.streamlineCount()) + " fibers) to " +
+                    save.path;
+    state_.bundling.message = state_.status;
+    std::fprintf(stderr, "fibscope view: %s\n", state_.status.c_str());
+  } catch (const Error& e) {
+    state_.status = e.what();
+    state_.bundling.message = e.what();
+    std::fprintf(stderr, "fibscope view: %s\n", e.what());
   }
 }
 
@@ -1274,6 +1447,7 @@ void ViewerApp::run() {
     pollAnatomy();
     pollRawDecode();
     pollExport();
+    pollBundling();
     // Frames and the script count once the models named at start are in.
     const bool starting = !startup_jobs_.empty();
     const auto now = Clock::now();
@@ -1289,7 +1463,8 @@ void ViewerApp::run() {
         for (const ViewerAction& action : input_.map(event, imgui_->wantsMouse(), imgui_->wantsKeyboard()))
           apply(action);
     if (!starting)
-      for (const ViewerAction& action : script_.nextFrame(loader_->busy() || anatomy_.loading(), dissection_->exporting())) apply(action);
+      for (const ViewerAction& action : script_.nextFrame(loader_->busy() || anatomy_.loading(), dissection_->exporting(),
+                                                                  state_.bundling.running)) apply(action);
     if (!starting && options_.orbit_deg_per_frame != 0)
       controller_.rotate(options_.orbit_deg_per_frame / OrbitController::kDegreesPerPixel, 0);
     // A quit still draws this frame: a screenshot asked for with it is taken.
@@ -1306,7 +1481,7 @@ void ViewerApp::run() {
     }
     // Offscreen nothing paces the frames: while a load runs, leave the
     // cores to the worker (a window is paced by vsync).
-    if (!window_ && (loader_->busy() || anatomy_.loading())) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    if (!window_ && (loader_->busy() || anatomy_.loading() || bundling_->running())) std::this_thread::sleep_for(std::chrono::milliseconds(10));
     const bool frames_done_enough = options_.frames > 0 && frames_done >= options_.frames;
     const bool script_done = !script_.empty() && script_.finished() && !starting;
     if (!window_ || options_.frames > 0 || !script_.empty()) {

@@ -6,6 +6,7 @@
 #include <optional>
 #include <sstream>
 
+#include "app/bundle_output.h"
 #include "app/render_options.h"
 #include "core/error.h"
 #include "select/cuts.h"
@@ -170,7 +171,7 @@ std::optional<ViewerAction> parseDissectionCommand(const std::vector<std::string
   return std::nullopt;
 }
 
-std::variant<ViewerAction, WaitFrames, WaitLoaded, WaitExported> parseCommand(const std::vector<std::string_view>& w) {
+std::variant<ViewerAction, WaitFrames, WaitLoaded, WaitExported, WaitBundled> parseCommand(const std::vector<std::string_view>& w) {
   const std::string_view name = w[0];
   if (std::optional<ViewerAction> dissection = parseDissectionCommand(w)) return *dissection;
   if (name == "orbit" || name == "pan") {
@@ -274,6 +275,62 @@ std::variant<ViewerAction, WaitFrames, WaitLoaded, WaitExported> parseCommand(co
     expectArguments(w, 1, 1, "anatomy FILE.nii[.gz]");
     return ViewerAction{AnatomyAction{std::string(w[1])}};
   }
+  if (name == "bundle") {
+    BundleAction bundle;
+    BundleParams& p = bundle.params;
+    for (size_t i = 1; i < w.size(); ++i) {
+      const size_t eq = w[i].find('=');
+      if (eq == std::string_view::npos)
+        throw Error("bundle: expected KEY=VALUE, got '" + std::string(w[i]) + "'");
+      const std::string_view key = w[i].substr(0, eq), value = w[i].substr(eq + 1);
+      if (key == "mode") {
+        p.mode = parseBundleMode(std::string(value));
+        continue;
+      }
+      const double v = number(value, std::string(key).c_str());
+      if (key == "radius") p.radius = v;
+      else if (key == "iterations") {
+        if (!(v >= 1 && v <= 1000) || v != std::floor(v))
+          throw Error("bundle: iterations: expected 1 to 1000, got " + std::string(value));
+        p.iterations = uint32_t(v);
+      } else if (key == "voxel") p.voxel_mm = v;
+      else if (key == "step") p.step_mm = v;
+      else if (key == "smoothing") p.smoothing = v;
+      else if (key == "relaxation") p.relaxation = v;
+      else if (key == "decay") p.radius_decay = v;
+      else if (key == "advection") p.advection = v;
+      else if (key == "anisotropy") p.anisotropy = v;
+      else
+        throw Error("bundle: unknown key '" + std::string(key) +
+                    "' (expected radius, iterations, voxel, step, smoothing, relaxation, decay, advection, "
+                    "anisotropy or mode)");
+    }
+    try {
+      validateBundleParams(p);
+    } catch (const Error& e) {
+      throw Error(std::string("bundle: ") + e.what());
+    }
+    return ViewerAction{bundle};
+  }
+  if (name == "wait-bundle") {
+    expectArguments(w, 0, 0, "wait-bundle");
+    return WaitBundled{};
+  }
+  if (name == "show-model" || name == "save-model") {
+    const bool save = name == "save-model";
+    expectArguments(w, save ? 2 : 1, save ? 2 : 1, save ? "save-model N PATH" : "show-model N");
+    const double n = number(w[1], "N");
+    if (!(n >= 0 && n < 65536) || n != std::floor(n))
+      throw Error(std::string(name) + ": expected a model index from 0 (the first opened), got " + std::string(w[1]));
+    if (!save) return ViewerAction{ShowOnlyModelAction{int(n)}};
+    const std::string path(w[2]);
+    try {
+      checkBundledOutputPath(path);
+    } catch (const Error& e) {
+      throw Error(std::string("save-model: ") + e.what());
+    }
+    return ViewerAction{SaveModelAction{int(n), path}};
+  }
   if (name == "quit") {
     expectArguments(w, 0, 0, "quit");
     return ViewerAction{QuitAction{}};
@@ -283,7 +340,7 @@ std::variant<ViewerAction, WaitFrames, WaitLoaded, WaitExported> parseCommand(co
               "pick, clear-selection, export-selection, expect-selected, roi-add, roi-place, roi-remove, "
               "roi-enable, ends-only, length, fiber-scalar, fiber-scalar-clear, clip-plane-add, clip-plane-clear, cut-mesh-add, cut-mesh-clear, slab, "
               "dropped, roi-save, roi-load, "
-              "export-kept, expect-kept, resize, anatomy or quit)");
+              "export-kept, expect-kept, resize, anatomy, bundle, wait-bundle, show-model, save-model or quit)");
 }
 
 }  // namespace
@@ -327,8 +384,12 @@ std::vector<ScriptStep> loadScript(const std::string& path) {
   return parseScript(text.str(), path);
 }
 
-std::vector<ViewerAction> ScriptRunner::nextFrame(bool loading, bool exporting) {
+std::vector<ViewerAction> ScriptRunner::nextFrame(bool loading, bool exporting, bool bundling) {
   std::vector<ViewerAction> actions;
+  if (waiting_bundled_) {
+    if (bundling) return actions;
+    waiting_bundled_ = false;
+  }
   if (waiting_loaded_) {
     if (loading) return actions;
     waiting_loaded_ = false;
@@ -357,6 +418,12 @@ std::vector<ViewerAction> ScriptRunner::nextFrame(bool loading, bool exporting) 
       // The export was started by the actions of this frame: checked from
       // the next frame on, as wait-loaded.
       waiting_exported_ = true;
+      break;
+    }
+    if (std::holds_alternative<WaitBundled>(step.command)) {
+      // The job was started by the actions of this frame: checked from the
+      // next frame on, as wait-loaded.
+      waiting_bundled_ = true;
       break;
     }
     const ViewerAction& action = std::get<ViewerAction>(step.command);

@@ -33,6 +33,13 @@
 //   roi-save FILE.json | roi-load FILE.json   (a load that fails keeps the state, the error is shown)
 //   export-kept OUT.tck|.trk|.trx  (the active model's kept fibers, as `fibscope filter`; holds until written)
 //   expect-kept N              (the run fails naming the line unless the filter keeps N fibers)
+// bundling (viewer_bundling.h):
+//   bundle [KEY=VALUE ...]     (the active model on a worker; KEY: radius iterations voxel step smoothing
+//                              relaxation decay advection anisotropy mode=isotropic|anisotropic, as
+//                              `fibscope bundle`'s options; 0 for voxel or step: the default fraction)
+//   wait-bundle                (holds until the bundled copy is a model: shown and active, the source hidden)
+//   show-model N               (model N shown and active, the others hidden: original / bundled)
+//   save-model N PATH          (.tck .trk .trx .fbl, as `fibscope bundle` writes; an existing PATH is refused)
 //   quit
 #pragma once
 
@@ -55,9 +62,12 @@ struct WaitLoaded {};
 // Follows export-kept: holds until the export is written.
 struct WaitExported {};
 
+// Follows bundle (or stands alone): holds until the bundled copy is loaded.
+struct WaitBundled {};
+
 struct ScriptStep {
   int line = 0;  // 1-based, for messages
-  std::variant<ViewerAction, WaitFrames, WaitLoaded, WaitExported> command;
+  std::variant<ViewerAction, WaitFrames, WaitLoaded, WaitExported, WaitBundled> command;
 };
 
 // Parses a whole script. `path` only names the script in messages. Throws
@@ -77,9 +87,10 @@ class ScriptRunner {
   // next `wait` (which then holds for its frames), `wait-loaded` (which
   // holds while `loading`) or export-kept (holds while `exporting`), or
   // none while waiting.
-  std::vector<ViewerAction> nextFrame(bool loading = false, bool exporting = false);
+  // wait-bundle holds while `bundling`.
+  std::vector<ViewerAction> nextFrame(bool loading = false, bool exporting = false, bool bundling = false);
   bool finished() const {
-    return next_ >= steps_.size() && waiting_ == 0 && !waiting_loaded_ && !waiting_exported_;
+    return next_ >= steps_.size() && waiting_ == 0 && !waiting_loaded_ && !waiting_exported_ && !waiting_bundled_;
   }
   bool empty() const { return steps_.empty(); }
 
@@ -89,6 +100,7 @@ class ScriptRunner {
   uint32_t waiting_ = 0;
   bool waiting_loaded_ = false;
   bool waiting_exported_ = false;
+  bool waiting_bundled_ = false;
 };
 
 }  // namespace fibscope

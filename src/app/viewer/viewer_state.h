@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "app/viewer/dissection.h"
+#include "bundling/bundle_params.h"
 #include "render/camera.h"
 #include "render/render_settings.h"
 
@@ -50,6 +51,18 @@ struct LoadingInfo {
   double eta_seconds = -1;     // -1: unknown
   double elapsed_seconds = 0;
   size_t queued = 0;  // further jobs waiting behind this one
+};
+
+// The Bundle panel (viewer_ui_bundling.cpp): its parameters, the running
+// job's progress, and the last source and bundled copy (indices into
+// ViewerState::models, -1: none).
+struct BundlingInfo {
+  BundleParams params;  // the paper's defaults
+  bool running = false;  // bundling or loading the copy
+  LoadingInfo progress;
+  int source_model = -1, bundled_model = -1;
+  std::string message;  // the last result or error
+  std::string save_path = "bundled.tck";
 };
 
 // One frame's numbers, kept for the performance overlay's history.
@@ -129,6 +142,8 @@ struct ViewerState {
   // that could not be read) or what just happened.
   std::string status;
 
+  BundlingInfo bundling;
+
   // UI flags.
   bool show_settings = true;
   bool show_performance = true;
@@ -138,6 +153,7 @@ struct ViewerState {
   // plane (as the selection panel appears with a selection).
   bool show_dissection = false;
   bool show_anatomy = true;
+  bool show_bundling = true;
   std::string screenshot_path = "fibscope.png";  // the screenshot button's file
   std::string open_path;                         // the models panel's path entry
   int screenshot_width = 0, screenshot_height = 0;  // 0: the window as shown

@@ -195,6 +195,7 @@ std::vector<ViewerAction> drawViewerUi(ViewerState& state) {
       ImGui::MenuItem("Selection", nullptr, &state.show_selection);
       ImGui::MenuItem("Dissection", nullptr, &state.show_dissection);
       ImGui::MenuItem("Anatomy", nullptr, &state.show_anatomy);
+      ImGui::MenuItem("Bundle", nullptr, &state.show_bundling);
       ImGui::EndMenu();
     }
     if (ImGui::MenuItem("Screenshot")) actions.push_back(ScreenshotAction{});
@@ -208,6 +209,7 @@ std::vector<ViewerAction> drawViewerUi(ViewerState& state) {
   drawDissectionOverlay(state);
   if (state.show_dissection) drawDissectionPanel(state, actions);
   if (state.show_anatomy) drawAnatomyPanel(state, actions);
+  if (state.show_bundling) drawBundlingPanel(state, actions);
   statusLine(state);
   return actions;
 }

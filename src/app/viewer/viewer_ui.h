@@ -43,5 +43,9 @@ void drawDissectionOverlay(const ViewerState& state);
 // grid and values, the slices with sliders over its voxels, the display
 // range, opacity, sampling, the slab following the active slice).
 void drawAnatomyPanel(ViewerState& state, std::vector<ViewerAction>& actions);
+// viewer_ui_bundling.cpp: the Bundle panel (the bundling parameters, Bundle
+// and Cancel, the job's progress with rate and ETA, original / bundled,
+// Save bundled...).
+void drawBundlingPanel(ViewerState& state, std::vector<ViewerAction>& actions);
 
 }  // namespace fibscope

@@ -1,0 +1,60 @@
+// Bundling, constrained advection (shared/bundling.h; FiberVisualizer
+// section 7): one invocation per sample moves it by R h along the gradient
+// projected on the plane orthogonal to the fiber,
+//   u = d x (g x d) = g - d (d . g),  p += R h u / |g|,
+// g the density gradient interpolated trilinearly at p (between voxel
+// centres, clamped at the faces), d the unit direction of the fiber there
+// (central difference of the neighbouring samples, one-sided at the ends).
+// A sample whose gradient is shorter than kBundleMinGradient, or whose
+// neighbours coincide, stays; so do the end samples with anchor_ends.
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_buffer_reference : require
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+
+#include "shared/workgroup.h"
+layout(local_size_x_id = WORKGROUP_SIZE_X_ID) in;  // kBundleGroupSize
+
+#include "glsl/bundling.glsl"
+
+layout(push_constant, std430) uniform Push { BundleSamplePush pc; };
+
+vec3 gradientAt(uvec3 v) { return BundleVec4Ref(pc.field).values[bundleVoxelIndex(pc.grid, v.x, v.y, v.z)].xyz; }
+
+vec3 trilinearGradient(vec3 p) {
+  const vec3 size = vec3(pc.grid.nx, pc.grid.ny, pc.grid.nz);
+  const vec3 q = (p - vec3(pc.grid.origin_x, pc.grid.origin_y, pc.grid.origin_z)) / pc.grid.voxel - 0.5;
+  const vec3 i0 = clamp(floor(q), vec3(0.0), max(size - 2.0, vec3(0.0)));
+  const vec3 t = clamp(q - i0, vec3(0.0), vec3(1.0));
+  const uvec3 a = uvec3(i0);
+  const uvec3 b = uvec3(min(i0 + 1.0, size - 1.0));
+  const vec3 x00 = mix(gradientAt(uvec3(a.x, a.y, a.z)), gradientAt(uvec3(b.x, a.y, a.z)), t.x);
+  const vec3 x10 = mix(gradientAt(uvec3(a.x, b.y, a.z)), gradientAt(uvec3(b.x, b.y, a.z)), t.x);
+  const vec3 x01 = mix(gradientAt(uvec3(a.x, a.y, b.z)), gradientAt(uvec3(b.x, a.y, b.z)), t.x);
+  const vec3 x11 = mix(gradientAt(uvec3(a.x, b.y, b.z)), gradientAt(uvec3(b.x, b.y, b.z)), t.x);
+  return mix(mix(x00, x10, t.y), mix(x01, x11, t.y), t.z);
+}
+
+void main() {
+  const uint i = bundleInvocation();
+  if (i >= pc.sample_count) return;
+  BundleVec4Ref src = BundleVec4Ref(pc.src);
+  const vec4 p = src.values[i];
+  const uint fiber = BundleUintsRef(pc.sample_fiber).values[i];
+  const uint s0 = BundleUintsRef(pc.sample_offsets).values[fiber];
+  const uint s1 = BundleUintsRef(pc.sample_offsets).values[fiber + 1u];
+  vec4 result = p;
+  const bool end = i == s0 || i + 1u == s1;
+  if (!(end && pc.anchor_ends != 0u)) {
+    const vec3 along = src.values[min(i + 1u, s1 - 1u)].xyz - src.values[i > s0 ? i - 1u : i].xyz;
+    const vec3 g = trilinearGradient(p.xyz);
+    const float glen = length(g);
+    const float alen = length(along);
+    if (glen > kBundleMinGradient && alen > 0.0) {
+      const vec3 d = along / alen;
+      const vec3 u = g - d * dot(d, g);
+      result = vec4(p.xyz + u * (pc.step / glen), p.w);
+    }
+  }
+  BundleVec4Ref(pc.dst).values[i] = result;
+}

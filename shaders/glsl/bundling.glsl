@@ -1,0 +1,32 @@
+// Buffer-reference types and helpers of the bundling passes (GLSL only;
+// the pushes come from shared/bundling.h). Requires GL_EXT_buffer_reference
+// and GL_EXT_shader_explicit_arithmetic_types_int64 in the including shader.
+#ifndef FIBSCOPE_GLSL_BUNDLING_GLSL
+#define FIBSCOPE_GLSL_BUNDLING_GLSL
+
+#include "shared/bundling.h"
+
+layout(buffer_reference, std430, buffer_reference_align = 4) buffer BundleFloatsRef { float values[]; };
+layout(buffer_reference, std430, buffer_reference_align = 4) buffer BundleUintsRef { uint values[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer BundleVec4Ref { vec4 values[]; };
+
+// The flattened invocation index of a 2D dispatch grid (gpu::dispatchGrid).
+// Include after the layout(local_size_x_id ...) declaration: before it,
+// gl_WorkGroupSize is the default 1, not the specialised size.
+uint bundleInvocation() {
+  return (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x + gl_LocalInvocationIndex;
+}
+
+uint bundleVoxelIndex(BundleGridBlock g, uint x, uint y, uint z) { return x + g.nx * (y + g.ny * z); }
+
+// The voxel holding p, clamped into the grid.
+uvec3 bundleVoxelOf(BundleGridBlock g, vec3 p) {
+  const vec3 q = floor((p - vec3(g.origin_x, g.origin_y, g.origin_z)) / g.voxel);
+  return uvec3(clamp(q, vec3(0.0), vec3(g.nx - 1u, g.ny - 1u, g.nz - 1u)));
+}
+
+vec3 bundlePoint(BundleFloatsRef points, uint i) {
+  return vec3(points.values[3u * i], points.values[3u * i + 1u], points.values[3u * i + 2u]);
+}
+
+#endif
