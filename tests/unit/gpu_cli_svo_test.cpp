@@ -44,10 +44,14 @@ TEST_F(GpuCliSvo, renderDrawsThePhantomAsOctreeTracedTubes) {
 TEST_F(GpuCliSvo, badRadiusOrVoxelIsOneLineAndExitCode2) {
   const std::string common = "render --phantom-streamlines 10 --size 32x32 --pipeline svo-straight -o " + dir_.file("x.png");
   for (const std::string& bad : {std::string(" --tube-radius 0"), std::string(" --tube-radius -1"),
-                                 std::string(" --tube-radius 0.5 --voxel 0"), std::string(" --tube-radius 0.5 --voxel -2")}) {
+                                 std::string(" --tube-radius 0.5 --voxel 0"), std::string(" --tube-radius 0.5 --voxel -2"),
+                                 std::string(" --tube-radius 0.5 --voxel 0.001")}) {
     const auto r = runFibscope(common + bad);
     EXPECT_EQ(r.exit_code, 2) << bad << ": " << r.output;
-    EXPECT_NE(r.output.find("fibscope: error: --"), std::string::npos) << bad << ": " << r.output;
+    // The option named, or (a voxel too fine for the octree) the side it would need.
+    EXPECT_TRUE(r.output.find("fibscope: error: --") != std::string::npos ||
+                r.output.find("voxels a side") != std::string::npos)
+        << bad << ": " << r.output;
     EXPECT_EQ(r.output.find('\n'), r.output.size() - 1) << bad << ": " << r.output;
   }
 }
