@@ -168,16 +168,7 @@ void runRender(RenderCommandOptions o) {
       build.progress = true;
       const SvoTree tree = buildSvoGpu(context, model, tubes, grid, build, &svo_stats);
       svo_tree = uploadSvo(context, tree);
-      svo_line = "svo: " + std::to_string(model.segments.size()) + " segments (" +
-                 std::to_string(double(model.deviceBytes()) / 1e6) + " MB streamline buffer), voxel " +
-                 std::to_string(grid.voxel) + " mm, " + std::to_string(grid.side()) + "^3 grid in " +
-                 std::to_string(svo_stats.slabs) + " slabs, " + std::to_string(tree.leaves) + " leaves (" +
-                 std::to_string(tree.leaves_over_4) + " with more than 4 segments, at most " +
-                 std::to_string(tree.max_segments_per_leaf) + "), nodes " +
-                 std::to_string(double(tree.nodeBytes()) / 1e6) + " MB, decoration " +
-                 std::to_string(double(tree.decorationBytes()) / 1e6) + " MB; voxelise " +
-                 std::to_string(svo_stats.voxelize_s) + " s, sort " + std::to_string(svo_stats.sort_s) +
-                 " s, build " + std::to_string(svo_stats.tree_s) + " s";
+      svo_line = svoBuildSummary(model, tree, svo_stats);
     }
     if (o.tubes.dim_rest && !o.render.dim_dropped) {
       tube_words.assign((scene.streamlines + 31) / 32, 0u);

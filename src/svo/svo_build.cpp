@@ -104,14 +104,15 @@ SvoMemoryNeed estimateSvoMemory(const TubeModel& model, const SvoGrid& grid, uin
     // segment: an upper bound where segments join).
     shell += M_PI * (ro * ro - ri * ri) * len + 4.0 / 3.0 * M_PI * (ro * ro * ro - ri * ri * ri);
   }
-  need.leaves = uint64_t(std::ceil(shell / (h * h * h))) + 1;
+  // Each segment's own band voxels: the (leaf, segment) references, and an
+  // upper bound of the leaves (a leaf holds at least one reference).
+  const uint64_t references = uint64_t(std::ceil(shell / (h * h * h))) + 1;
+  need.leaves = references;
   const uint64_t side = grid.side();
   need.field = side * side * std::min<uint64_t>(slab_depth, side) * 4;
   need.sort = need.leaves * 4 * 4;
   need.nodes = need.leaves * 8 * 8 / 7 + 8;
-  // Each leaf lists the capsules of about as many segments as meet there:
-  // count the shell voxels of every segment (an upper bound of the references).
-  need.decoration = (need.leaves + need.leaves) * 4;
+  need.decoration = (need.leaves + references) * 4;  // a count per leaf, an index per reference
   return need;
 }
 

@@ -57,7 +57,7 @@ SvoGrid chooseSvoGrid(const TubeModel& model, float voxel_mm);
 
 // What a build will allocate, estimated before allocating (bytes).
 struct SvoMemoryNeed {
-  uint64_t leaves = 0;      // estimated narrow-band voxels (band shell of each capsule)
+  uint64_t leaves = 0;      // narrow-band voxels, bounded by the sum of every capsule's band shell / voxel^3
   uint64_t field = 0;       // the GPU's dense distance slab
   uint64_t sort = 0;        // leaf keys and values, twice (the sort's ping-pong)
   uint64_t nodes = 0;       // tree, about 8/7 of the leaves' blocks

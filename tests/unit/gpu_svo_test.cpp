@@ -6,7 +6,9 @@
 // Intel Embree's round linear curves. Validation layers on.
 #include <gtest/gtest.h>
 
+#if FIBSCOPE_HAVE_EMBREE
 #include <embree3/rtcore.h>
+#endif
 
 #include <algorithm>
 #include <cmath>
@@ -222,9 +224,10 @@ TEST_F(GpuSvoTrace, straightTubesMatchBruteForceRayCapsuleOnADenseBundle) {
   const Tractogram t = test::denseSvoBundle();
   const TubeModel model = buildTubes(t, test::svoTubeOptions(0.3f));
   const SvoGrid grid = chooseSvoGrid(model, 0.0f);
-  const std::array<double, 3> views[] = {{0.3, -1.0, 0.6}, {1.0, 0.2, 0.1}, {0.1, 0.1, 1.0}};
+  // Oblique and from above (small frames: the reference is O(pixels x segments)).
+  const std::array<double, 3> views[] = {{0.3, -1.0, 0.6}, {0.1, 0.1, 1.0}};
   std::vector<Camera> cameras;
-  for (const auto& v : views) cameras.push_back(test::svoCamera(t, v[0], v[1], v[2], 96, 80));
+  for (const auto& v : views) cameras.push_back(test::svoCamera(t, v[0], v[1], v[2], 80, 64));
   SvoTree tree;
   const auto frames = traceOnGpu(context(), model, grid, cameras, &tree);
   // The seed's 4-nearest lists would lose tubes here.
@@ -245,7 +248,8 @@ TEST_F(GpuSvoTrace, straightTubesMatchBruteForceRayCapsuleOnADenseBundle) {
     const TraceAgreement a = compareTrace(gpu, ref.fiber, ref_z, camera);
     const std::string what = "view (" + std::to_string(v[0]) + ", " + std::to_string(v[1]) + ", " +
                              std::to_string(v[2]) + "): " + a.summary();
-    EXPECT_GT(a.both, 500u) << what;  // measured: 600 to 1,419
+    std::printf("brute force, %s\n", what.c_str());
+    EXPECT_GT(a.both, 500u) << what;
     EXPECT_EQ(a.disagree, 0u) << what;
     EXPECT_EQ(a.fiber_mismatch, 0u) << what;
     EXPECT_LE(a.max_depth_mm, 1e-4) << what;
@@ -259,6 +263,7 @@ TEST_F(GpuSvoTrace, straightTubesMatchBruteForceRayCapsuleOnADenseBundle) {
   }
 }
 
+#if FIBSCOPE_HAVE_EMBREE
 // Embree's round linear curves of constant radius: a segment's cone with
 // spheres at both ends, which for one radius is the capsule.
 struct EmbreeFrame {
@@ -336,8 +341,18 @@ EmbreeFrame traceEmbree(const TubeModel& model, const Camera& camera) {
   rtcReleaseDevice(device);
   return frame;
 }
+#endif
+
+// Skips, naming the reason, where the build has no Embree.
+#if FIBSCOPE_HAVE_EMBREE
+#define REQUIRE_EMBREE()
+#else
+#define REQUIRE_EMBREE() GTEST_SKIP() << "Embree not installed (Debian's libembree-dev): no independent reference"
+#endif
 
 TEST_F(GpuSvoTrace, straightTubesAgreeWithEmbreeRoundLinearCurves) {
+  REQUIRE_EMBREE();
+#if FIBSCOPE_HAVE_EMBREE
   const Tractogram t = test::denseSvoBundle();
   const TubeModel model = buildTubes(t, test::svoTubeOptions(0.3f));
   const SvoGrid grid = chooseSvoGrid(model, 0.0f);
@@ -359,9 +374,11 @@ TEST_F(GpuSvoTrace, straightTubesAgreeWithEmbreeRoundLinearCurves) {
     ++agree;
     max_depth = std::max(max_depth, std::fabs(viewZ(camera, gpu[i].depth) - ref.z[i]));
   }
+  std::printf("Embree: %zu of %zu covered pixels the same fiber, depth within %.2e mm\n", agree, covered, max_depth);
   ASSERT_GT(covered, 1000u);  // measured: 1,601
   EXPECT_GE(double(agree) / double(covered), 0.999) << agree << " of " << covered;
   EXPECT_LE(max_depth, 1e-3) << agree << " of " << covered;
+#endif
 }
 
 // Figures for docs/BENCHMARKS.md, not a check: runs only with
@@ -372,6 +389,8 @@ TEST_F(GpuSvoTrace, straightTubesAgreeWithEmbreeRoundLinearCurves) {
 // of the same CPU.
 TEST_F(GpuSvoTrace, benchmarkAgainstEmbreeWhenAsked) {
   if (!std::getenv("FIBSCOPE_SVO_BENCH")) GTEST_SKIP() << "set FIBSCOPE_SVO_BENCH=1 to measure";
+  REQUIRE_EMBREE();
+#if FIBSCOPE_HAVE_EMBREE
   using Clock = std::chrono::steady_clock;
   std::printf("| fibers | segments | streamline buffer MB | voxel mm | grid | leaves | >4 | nodes MB | decoration MB | "
               "voxelise s | sort s | build s | SVO trace ms | Embree build+trace ms |\n");
@@ -411,6 +430,7 @@ TEST_F(GpuSvoTrace, benchmarkAgainstEmbreeWhenAsked) {
                 grid.voxel, grid.side(), tree.leaves, tree.leaves_over_4, double(tree.nodeBytes()) / 1e6,
                 double(tree.decorationBytes()) / 1e6, st.voxelize_s, st.sort_s, st.tree_s, trace_ms, embree_ms);
   }
+#endif
 }
 
 }  // namespace

@@ -269,6 +269,19 @@ SvoTree buildSvoGpu(const gpu::VulkanContext& context, const TubeModel& model, c
   return tree;
 }
 
+std::string svoBuildSummary(const TubeModel& model, const SvoTree& tree, const SvoGpuBuildStats& stats) {
+  char text[512];
+  std::snprintf(text, sizeof(text),
+                "svo: %zu segments (streamline buffer %.3f MB), voxel %.3f mm, %u^3 grid in %u slabs, %zu leaves (%zu "
+                "with more than 4 segments, at most %zu), nodes %.3f MB, decoration %.3f MB; voxelise %.3f s, sort "
+                "%.3f s, build %.3f s",
+                model.segments.size(), double(model.deviceBytes()) / 1e6, tree.grid.voxel, tree.grid.side(),
+                stats.slabs, tree.leaves, tree.leaves_over_4, tree.max_segments_per_leaf,
+                double(tree.nodeBytes()) / 1e6, double(tree.decorationBytes()) / 1e6, stats.voxelize_s, stats.sort_s,
+                stats.tree_s);
+  return text;
+}
+
 GpuSvo uploadSvo(const gpu::VulkanContext& context, const SvoTree& tree) {
   GpuSvo svo;
   svo.grid = tree.grid;

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "gpu/buffer.h"
@@ -50,6 +51,10 @@ std::vector<SvoLeaf> voxelizeSvoLeavesGpu(const gpu::VulkanContext& context, con
 // needed when the estimate exceeds the memory limit.
 SvoTree buildSvoGpu(const gpu::VulkanContext& context, const TubeModel& model, const GpuTubes& tubes,
                     const SvoGrid& grid, const SvoGpuBuildOptions& options = {}, SvoGpuBuildStats* stats = nullptr);
+
+// One line for the command line: segments, streamline buffer, grid,
+// leaves (and those over 4 segments), nodes and decoration MB, the times.
+std::string svoBuildSummary(const TubeModel& model, const SvoTree& tree, const SvoGpuBuildStats& stats);
 
 struct GpuSvo {
   gpu::Buffer nodes;       // SvoNode[]
