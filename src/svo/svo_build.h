@@ -50,7 +50,9 @@ float capsuleDistance(const SvoCapsule& c, const glm::vec3& p);
 // neighbouring tubes stays apart down to a gap of about one voxel), no finer
 // than the median segment length / 2 (finer voxels than the segments add
 // leaves without adding detail: each leaf still holds the same capsules),
-// then coarsened until the box fits in 2^kSvoMaxLevels voxels. Throws Error
+// no coarser than r_min (a leaf then lists the segments of a few radii
+// around it, not of a whole bundle), then coarsened by 1.25x until the box
+// fits in 2^kSvoMaxLevels voxels. Throws Error
 // when voxel_mm < 0 or not finite, the model has no segment, or a given
 // voxel needs more than 2^kSvoMaxLevels voxels a side (naming the side).
 SvoGrid chooseSvoGrid(const TubeModel& model, float voxel_mm);
