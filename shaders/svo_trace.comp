@@ -14,6 +14,15 @@
 // ends the walk. A hit past the leaf's exit is not taken there: a nearer
 // surface may lie in the leaves between, and the hit's own leaf lists its
 // capsule (shared/svo.h's band rule).
+//
+// Curved (pc.curved, svo-curved): in a leaf, sphere tracing of the union
+// (min) of its list's curved-tube distances (glsl/svo_curve.glsl) from the
+// leaf's entry less the slack, at most kSvoSphereSteps steps, a hit where
+// the union falls below kSvoHitEpsilon * voxel before the leaf's exit plus
+// the slack. The union of the list bounds the distance to the list's
+// surfaces from below (each distance is exact), so no step crosses one;
+// surfaces of segments not in the list do not enter the leaf. Normal: the
+// distance's gradient, p - C(u*) at the nearest point u*.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_buffer_reference : require
@@ -25,6 +34,7 @@
 #include "glsl/shade_common.glsl"
 #include "glsl/tangent.glsl"
 #include "glsl/svo_capsule.glsl"
+#include "glsl/svo_curve.glsl"
 
 layout(local_size_x_id = WORKGROUP_SIZE_X_ID, local_size_y_id = WORKGROUP_SIZE_Y_ID) in;  // kSvoTraceTile^2
 
@@ -70,7 +80,9 @@ void main() {
   uint restart_node = 0u, restart_level = 0u;
   uvec3 restart_cell = uvec3(0u);
   uint best_seg = 0xFFFFFFFFu;
-  float best_t = 0.0;
+  float best_t = 0.0, best_u = 0.0;
+  const bool curved = pc.curved != 0u;
+  const float hit_eps = kSvoHitEpsilon * voxel;
   // A bound on the walk (a ray crosses at most 3 * side leaves; each walk
   // step is one restart).
   const uint max_steps = 3u * side + 64u;
@@ -109,6 +121,36 @@ void main() {
       if (type == kSvoNodeLeaf) {
         const uint list = ref & kSvoNodeIndexMask;
         const uint count = DecorationRef(pc.decoration).words[list];
+        if (curved) {
+          float t = max(t0 - slack, 0.0);
+          const float t_end = t_exit + slack;
+          for (uint it = 0u; it < kSvoSphereSteps && t <= t_end; ++it) {
+            const vec3 q = o + t * d;
+            float f = 1e30, fu = 0.0;
+            uint fs = 0xFFFFFFFFu;
+            for (uint k = 0u; k < count; ++k) {
+              const uint seg = DecorationRef(pc.decoration).words[list + 1u + k];
+              const TubeSegment s = SegmentsRef(pc.segments).segments[seg];
+              float u;
+              const float fk = svoCurveDistance(
+                  svoCurveOf(NodesRef(pc.nodes).nodes[s.node], NodesRef(pc.nodes).nodes[s.node + 1u], s.chord), q, u);
+              if (fk < f || (fk == f && seg < fs)) {
+                f = fk;
+                fu = u;
+                fs = seg;
+              }
+            }
+            if (f < hit_eps) {
+              best_seg = fs;
+              best_t = t;
+              best_u = fu;
+              break;
+            }
+            t += f;
+          }
+          t0 = max(t_exit, t0 + nudge);
+          break;
+        }
         float leaf_best = t_exit + slack;
         for (uint k = 0u; k < count; ++k) {
           const uint seg = DecorationRef(pc.decoration).words[list + 1u + k];
@@ -136,6 +178,21 @@ void main() {
   if (depth < 0.0 || depth > 1.0 || !(depth < SurfaceRef(pc.surface).texels[index].depth)) return;
   const TubeSegment s = SegmentsRef(pc.segments).segments[best_seg];
   const TubeNode na = NodesRef(pc.nodes).nodes[s.node], nb = NodesRef(pc.nodes).nodes[s.node + 1u];
+  if (curved) {
+    const SvoCurveF cv = svoCurveOf(na, nb, s.chord);
+    const vec3 centre = svoCurvePoint(cv, best_u), along = svoCurveDerivative(cv, best_u);
+    SurfaceTexel texel;
+    texel.depth = depth;
+    texel.fiber = s.fiber;
+    texel.normal = packSegmentTangent(hit - centre);
+    texel.tangent = dot(along, along) > 0.0 ? packSegmentTangent(along) : texel.normal;
+    texel.position = mix(na.point, nb.point, best_u);
+    texel.color = 0u;
+    texel.source = kSurfaceSourceSvo;
+    texel.pad0 = 0u;
+    SurfaceRef(pc.surface).texels[index] = texel;
+    return;
+  }
   const SvoCapsuleF c = svoCapsuleOf(na, nb);
   const vec3 ba = c.b - c.a;
   const float baba = dot(ba, ba);

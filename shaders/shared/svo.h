@@ -39,6 +39,16 @@ SVO_CONST float kSvoBandScale = 0.8748f;
 // The ordered key of "no tube near": above every finite float's key.
 SVO_CONST uint kSvoFar = 0xFFFFFFFFu;
 
+// Curved tubes (svo-curved; src/svo/svo_build.h curveDistance,
+// glsl/svo_curve.glsl): the nearest point of a cubic segment from
+// kSvoCurveSamples + 1 samples and kSvoCurveNewtonSteps Newton steps; the
+// sphere tracing in a leaf takes at most kSvoSphereSteps steps and hits
+// where the union's distance is below kSvoHitEpsilon * voxel.
+SVO_CONST uint kSvoCurveSamples = 8u;
+SVO_CONST uint kSvoCurveNewtonSteps = 4u;
+SVO_CONST uint kSvoSphereSteps = 48u;
+SVO_CONST float kSvoHitEpsilon = 1e-3f;
+
 // Node reference word: the type in the top two bits, an index below.
 SVO_CONST uint kSvoNodeEmpty = 0u;             // no leaf below
 SVO_CONST uint kSvoNodeInternal = 0x40000000u; // index: node index of child 0 of its 2x2x2 block
@@ -102,7 +112,7 @@ struct SvoVoxelizePush {
   uint slab_depth;
   uint segment_count;
   float band;
-  uint pad0;
+  uint curved;  // 1: curved tubes (glsl/svo_curve.glsl), 0: capsules
   uint pad1;
   uint pad2;
 };
@@ -149,7 +159,10 @@ struct RadixPush {
 // for octrees) leaf by leaf; in each leaf it intersects the list's
 // capsules exactly and takes the nearest hit inside the leaf's stretch of
 // the ray; the first leaf with one ends the walk. Kept where its clip
-// depth lies in [0, 1] and is nearer than the surface texel's.
+// depth lies in [0, 1] and is nearer than the surface texel's. Curved: in
+// each leaf, sphere tracing of the union of the list's curved-tube
+// distances from the leaf's entry (at most kSvoSphereSteps steps), a hit
+// where it falls below kSvoHitEpsilon * voxel within the leaf's stretch.
 struct SvoTracePush {
   uint64_t camera;      // CameraBlock
   uint64_t svo_nodes;   // SvoNode[]
@@ -162,7 +175,7 @@ struct SvoTracePush {
   uint levels;
   uint width;
   uint height;
-  uint pad0;
+  uint curved;  // 1: sphere-trace the leaf's curved tubes (svo-curved), 0: exact capsules
 };
 
 SHADER_NAMESPACE_END

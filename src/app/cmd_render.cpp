@@ -36,15 +36,18 @@ struct RenderCommandOptions {
   std::string view;
   std::string camera;
   std::string output;
-  float voxel_mm = 0.0f;  // --voxel (svo-straight); 0: chosen from the data
+  float voxel_mm = 0.0f;  // --voxel (svo-straight, svo-curved); 0: chosen from the data
   bool voxel_given = false;
 };
 
 // `--pipeline svo-straight` (issue 16): the fibers of --tubes (all by
 // default) as straight streamtubes ray-traced from a sparse voxel octree,
 // over the compute pipeline's lines (each line lies inside its tube; the
-// fibers left out of --tubes stay lines).
+// fibers left out of --tubes stay lines). `--pipeline svo-curved`: the same
+// with each segment the tube around its cubic Hermite centre line,
+// sphere-traced in the octree's leaves.
 constexpr const char* kSvoStraight = "svo-straight";
+constexpr const char* kSvoCurved = "svo-curved";
 
 using Clock = std::chrono::steady_clock;
 double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
@@ -80,15 +83,17 @@ void runRender(RenderCommandOptions o) {
     throw Error("-o: the output must be a .png file, got '" + o.output + "'");
   if (!o.view.empty() && !o.camera.empty()) throw Error("--view and --camera: give one of them");
   const auto pipeline = o.render.values.find("pipeline");
-  const bool svo = pipeline != o.render.values.end() && pipeline->second == kSvoStraight;
+  const bool svo_curved = pipeline != o.render.values.end() && pipeline->second == kSvoCurved;
+  const bool svo = svo_curved || (pipeline != o.render.values.end() && pipeline->second == kSvoStraight);
   if (svo) {
     o.render.values["pipeline"] = "compute";
     if (o.tubes.fibers.empty()) o.tubes.fibers = "all";
-    // Straight capsules between the fiber's own points (resampling fits a
-    // Hermite curve, not a polyline).
+    // Tubes between the fiber's own points (resampling fits a Hermite
+    // curve, not a polyline; the curved tubes keep every point too, so
+    // straight and curved tubes share their nodes).
     if (o.tubes.resample_tolerance_mm < 0.0f) o.tubes.resample_tolerance_mm = 0.0f;
   }
-  if (o.voxel_given && !svo) throw Error("--voxel: only with --pipeline svo-straight");
+  if (o.voxel_given && !svo) throw Error("--voxel: only with --pipeline svo-straight or svo-curved");
   if (o.voxel_given && !(o.voxel_mm > 0.0f && std::isfinite(o.voxel_mm)))
     throw Error("--voxel: expected a voxel size > 0 mm, got " + std::to_string(o.voxel_mm));
   RenderSettings settings = renderSettingsFrom(o.render);
@@ -163,7 +168,7 @@ void runRender(RenderCommandOptions o) {
                                           filter.active() ? &kept : nullptr);
     tubes = uploadTubes(context, model);
     if (svo) {
-      const SvoGrid grid = chooseSvoGrid(model, o.voxel_mm);
+      const SvoGrid grid = chooseSvoGrid(model, o.voxel_mm, svo_curved);
       SvoGpuBuildOptions build;
       build.progress = true;
       const SvoTree tree = buildSvoGpu(context, model, tubes, grid, build, &svo_stats);
@@ -241,7 +246,7 @@ void addRenderCommand(CLI::App& app) {
   addRenderCliOptions(cmd, o->render);
   addTubeCliOptions(cmd, o->tubes);
   cmd->add_option("--voxel", o->voxel_mm,
-                  "Voxel size of the octree in mm, with --pipeline svo-straight (default: from the tube radius "
+                  "Voxel size of the octree in mm, with --pipeline svo-straight or svo-curved (default: from the tube radius "
                   "and the step)")
       ->each([o](const std::string&) { o->voxel_given = true; });
   cmd->add_option("--view", o->view, "sagittal | coronal | axial");

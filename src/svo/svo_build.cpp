@@ -17,10 +17,37 @@ glm::vec3 nodePosition(const shader::TubeNode& n) {
   return {n.position_radius.x, n.position_radius.y, n.position_radius.z};
 }
 
+// The segment as the grid takes it: a capsule or a curved tube.
+struct SegmentShape {
+  bool curved = false;
+  SvoCapsule capsule;
+  SvoCurve curve;
+  float radius() const { return curved ? curve.radius : capsule.radius; }
+  float distance(const glm::vec3& p) const { return curved ? curveDistance(curve, p) : capsuleDistance(capsule, p); }
+  void bounds(glm::vec3& lo, glm::vec3& hi) const {
+    if (curved) {
+      curveBounds(curve, lo, hi);
+    } else {
+      lo = glm::min(capsule.a, capsule.b);
+      hi = glm::max(capsule.a, capsule.b);
+    }
+  }
+};
+SegmentShape segmentShape(const TubeModel& model, const shader::TubeSegment& s, bool curved) {
+  SegmentShape shape;
+  shape.curved = curved;
+  if (curved) shape.curve = svoCurve(model, s);
+  else shape.capsule = svoCapsule(model, s);
+  return shape;
+}
+
 // The voxel box [lo, hi] (inclusive, clamped) whose centres lie within
 // `pad` of the segment's box.
-void voxelBox(const SvoGrid& grid, const SvoCapsule& c, float pad, glm::ivec3& lo, glm::ivec3& hi) {
-  const glm::vec3 bmin = glm::min(c.a, c.b) - pad, bmax = glm::max(c.a, c.b) + pad;
+void voxelBox(const SvoGrid& grid, const SegmentShape& c, float pad, glm::ivec3& lo, glm::ivec3& hi) {
+  glm::vec3 bmin, bmax;
+  c.bounds(bmin, bmax);
+  bmin -= pad;
+  bmax += pad;
   const int side = int(grid.side());
   for (int k = 0; k < 3; ++k) {
     lo[k] = std::max(0, int(std::floor((bmin[k] - grid.origin[k]) / grid.voxel - 0.5f)));
@@ -43,7 +70,57 @@ float capsuleDistance(const SvoCapsule& c, const glm::vec3& p) {
   return glm::length(pa - h * ba) - c.radius;
 }
 
-SvoGrid chooseSvoGrid(const TubeModel& model, float voxel_mm) {
+SvoCurve svoCurve(const TubeModel& model, const shader::TubeSegment& s) {
+  const shader::TubeNode& na = model.nodes[s.node];
+  const shader::TubeNode& nb = model.nodes[s.node + 1];
+  SvoCurve c;
+  c.p0 = nodePosition(na);
+  c.p1 = nodePosition(nb);
+  c.m0 = s.chord * glm::vec3(na.tangent_dradius.x, na.tangent_dradius.y, na.tangent_dradius.z);
+  c.m1 = s.chord * glm::vec3(nb.tangent_dradius.x, nb.tangent_dradius.y, nb.tangent_dradius.z);
+  c.radius = 0.5f * (na.position_radius.w + nb.position_radius.w);
+  return c;
+}
+
+float curveDistance(const SvoCurve& c, const glm::vec3& p, float* u_out) {
+  const uint32_t n = shader::kSvoCurveSamples;
+  float best_u = 0.0f, best = INFINITY;
+  for (uint32_t k = 0; k <= n; ++k) {
+    const float u = float(k) / float(n);
+    const glm::vec3 e = hermitePoint(c.p0, c.m0, c.p1, c.m1, u) - p;
+    const float d2 = glm::dot(e, e);
+    if (d2 < best) {
+      best = d2;
+      best_u = u;
+    }
+  }
+  float u = best_u;
+  for (uint32_t it = 0; it < shader::kSvoCurveNewtonSteps; ++it) {
+    const glm::vec3 e = hermitePoint(c.p0, c.m0, c.p1, c.m1, u) - p;
+    const glm::vec3 d1 = hermiteDerivative(c.p0, c.m0, c.p1, c.m1, u);
+    const glm::vec3 d2 = (12.0f * u - 6.0f) * c.p0 + (6.0f * u - 4.0f) * c.m0 + (6.0f - 12.0f * u) * c.p1 +
+                         (6.0f * u - 2.0f) * c.m1;
+    const float g = glm::dot(e, d1), h = glm::dot(d1, d1) + glm::dot(e, d2);
+    if (!(h > 0.0f)) break;
+    u = std::clamp(u - g / h, 0.0f, 1.0f);
+  }
+  const glm::vec3 e = hermitePoint(c.p0, c.m0, c.p1, c.m1, u) - p;
+  float d2 = glm::dot(e, e);
+  if (!(d2 <= best)) {
+    d2 = best;
+    u = best_u;
+  }
+  if (u_out) *u_out = u;
+  return std::sqrt(d2) - c.radius;
+}
+
+void curveBounds(const SvoCurve& c, glm::vec3& lo, glm::vec3& hi) {
+  const glm::vec3 b1 = c.p0 + c.m0 / 3.0f, b2 = c.p1 - c.m1 / 3.0f;
+  lo = glm::min(glm::min(c.p0, c.p1), glm::min(b1, b2));
+  hi = glm::max(glm::max(c.p0, c.p1), glm::max(b1, b2));
+}
+
+SvoGrid chooseSvoGrid(const TubeModel& model, float voxel_mm, bool curved) {
   if (!std::isfinite(voxel_mm) || voxel_mm < 0.0f)
     throw Error("svo: the voxel size must be > 0 mm (got " + std::to_string(voxel_mm) + ")");
   if (model.segments.empty()) throw Error("svo: no tube segment to voxelise");
@@ -52,9 +129,13 @@ SvoGrid chooseSvoGrid(const TubeModel& model, float voxel_mm) {
   std::vector<float> lengths;
   lengths.reserve(model.segments.size());
   for (const shader::TubeSegment& s : model.segments) {
-    const SvoCapsule c = svoCapsule(model, s);
-    lo = glm::min(lo, glm::min(c.a, c.b));
-    hi = glm::max(hi, glm::max(c.a, c.b));
+    const SegmentShape shape = segmentShape(model, s, curved);
+    const float radius = shape.radius();
+    glm::vec3 slo, shi;
+    shape.bounds(slo, shi);
+    lo = glm::min(lo, slo);
+    hi = glm::max(hi, shi);
+    const SvoCapsule c{slo, shi, radius};
     r_min = std::min(r_min, c.radius);
     r_max = std::max(r_max, c.radius);
     if (s.chord > 0.0f) lengths.push_back(s.chord);
@@ -69,6 +150,7 @@ SvoGrid chooseSvoGrid(const TubeModel& model, float voxel_mm) {
     }
   }
   SvoGrid grid;
+  grid.curved = curved;
   for (;;) {
     const float pad = r_max + 2.0f * shader::kSvoBandScale * voxel;
     const glm::vec3 extent = hi - lo + 2.0f * pad;
@@ -120,13 +202,13 @@ std::vector<SvoLeaf> voxelizeSvoLeaves(const TubeModel& model, const SvoGrid& gr
   const float band = grid.band();
   std::unordered_map<uint32_t, float> field;
   for (const shader::TubeSegment& s : model.segments) {
-    const SvoCapsule c = svoCapsule(model, s);
+    const SegmentShape c = segmentShape(model, s, grid.curved);
     glm::ivec3 lo, hi;
-    voxelBox(grid, c, c.radius + band, lo, hi);
+    voxelBox(grid, c, c.radius() + band, lo, hi);
     for (int z = lo.z; z <= hi.z; ++z)
       for (int y = lo.y; y <= hi.y; ++y)
         for (int x = lo.x; x <= hi.x; ++x) {
-          const float f = capsuleDistance(c, grid.center(uint32_t(x), uint32_t(y), uint32_t(z)));
+          const float f = c.distance(grid.center(uint32_t(x), uint32_t(y), uint32_t(z)));
           if (!(f < band)) continue;
           const uint32_t code = shader::svoMorton(uint32_t(x), uint32_t(y), uint32_t(z));
           auto [it, fresh] = field.emplace(code, f);
@@ -169,13 +251,13 @@ SvoTree buildSvoTree(const TubeModel& model, const SvoGrid& grid, const std::vec
   const float band = grid.band();
   std::vector<std::pair<uint32_t, uint32_t>> pairs;
   for (uint32_t si = 0; si < model.segments.size(); ++si) {
-    const SvoCapsule c = svoCapsule(model, model.segments[si]);
+    const SegmentShape c = segmentShape(model, model.segments[si], grid.curved);
     glm::ivec3 lo, hi;
-    voxelBox(grid, c, c.radius + band, lo, hi);
+    voxelBox(grid, c, c.radius() + band, lo, hi);
     for (int z = lo.z; z <= hi.z; ++z)
       for (int y = lo.y; y <= hi.y; ++y)
         for (int x = lo.x; x <= hi.x; ++x) {
-          const float f = capsuleDistance(c, grid.center(uint32_t(x), uint32_t(y), uint32_t(z)));
+          const float f = c.distance(grid.center(uint32_t(x), uint32_t(y), uint32_t(z)));
           if (!(std::fabs(f) < band)) continue;
           const uint32_t code = shader::svoMorton(uint32_t(x), uint32_t(y), uint32_t(z));
           const auto it = std::lower_bound(codes[levels].begin(), codes[levels].end(), code);

@@ -25,6 +25,9 @@ struct SvoGrid {
   glm::vec3 origin{0.0f};  // corner of voxel (0, 0, 0), mm
   float voxel = 1.0f;      // mm
   uint32_t levels = 0;     // side = 2^levels
+  // Curved tubes (svo-curved): each segment the tube of radius r around its
+  // cubic Hermite centre line (svoCurve) rather than the straight capsule.
+  bool curved = false;
   uint32_t side() const { return 1u << levels; }
   float band() const { return shader::kSvoBandScale * voxel; }
   glm::vec3 center(uint32_t x, uint32_t y, uint32_t z) const {
@@ -43,6 +46,33 @@ SvoCapsule svoCapsule(const TubeModel& model, const shader::TubeSegment& s);
 // segment minus r; a zero-length segment is a sphere), float as the shader.
 float capsuleDistance(const SvoCapsule& c, const glm::vec3& p);
 
+// The segment s of `model` as a curved tube (svo-curved): the cubic
+// Hermite centre line of the tube model (tubeSegmentPoint: ends p0, p1,
+// end derivatives m0, m1 = chord * tangent), radius as the capsule's (the
+// mean of the two node radii).
+struct SvoCurve {
+  glm::vec3 p0{0.0f}, m0{0.0f}, p1{0.0f}, m1{0.0f};
+  float radius = 0.0f;
+};
+SvoCurve svoCurve(const TubeModel& model, const shader::TubeSegment& s);
+
+// Signed distance of p to the curved tube: |p - C(u*)| - r at the nearest
+// point u* of the centre line C on [0, 1], found by sampling C at
+// kSvoCurveSamples + 1 evenly spaced u and refining the nearest sample by
+// kSvoCurveNewtonSteps clamped Newton steps on (C(u) - p) . C'(u) = 0 (the
+// smaller of the refined and the sampled distance is kept). Nearest-point
+// rather than the seed's domain transform f(Mp): the result is the true
+// distance wherever the nearest sample lies in the global minimum's basin
+// (segments of the tube model turn by well under 90 degrees), so the field
+// is 1-Lipschitz and sphere tracing never steps through a surface, and the
+// nearest point gives the normal and the position along the fiber
+// directly. `u_out` (may be null): u*. Float, as glsl/svo_curve.glsl.
+float curveDistance(const SvoCurve& c, const glm::vec3& p, float* u_out = nullptr);
+
+// A box holding the curved segment: the box of its Bezier control points
+// p0, p0 + m0 / 3, p1 - m1 / 3, p1 (the curve lies in their convex hull).
+void curveBounds(const SvoCurve& c, glm::vec3& lo, glm::vec3& hi);
+
 // The grid for `model`: the box of every capsule widened by r + 2 band,
 // cubic, 2^levels voxels a side. `voxel_mm` > 0 is taken as given; 0
 // chooses it from the data: r_min / 2 (two voxels per radius: a tube's
@@ -55,7 +85,9 @@ float capsuleDistance(const SvoCapsule& c, const glm::vec3& p);
 // fits in 2^kSvoMaxLevels voxels. Throws Error
 // when voxel_mm < 0 or not finite, the model has no segment, or a given
 // voxel needs more than 2^kSvoMaxLevels voxels a side (naming the side).
-SvoGrid chooseSvoGrid(const TubeModel& model, float voxel_mm);
+// `curved`: the box of the curved segments (curveBounds), and the grid's
+// `curved` flag set.
+SvoGrid chooseSvoGrid(const TubeModel& model, float voxel_mm, bool curved = false);
 
 // What a build will allocate, estimated before allocating (bytes).
 struct SvoMemoryNeed {
@@ -92,6 +124,8 @@ struct SvoTree {
 // at most (a hash of the band voxels).
 std::vector<SvoLeaf> voxelizeSvoLeaves(const TubeModel& model, const SvoGrid& grid);
 
+// Straight capsules, or curved tubes where grid.curved (also for the CPU
+// reference of the voxelisation above).
 // The tree over `leaves` (sorted by code, codes unique) and their lists:
 // segment s is in the list of a leaf where |f_s(centre)| < band. Internal
 // nodes from the leaves' codes level by level upward (code >> 3 is the

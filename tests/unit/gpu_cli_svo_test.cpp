@@ -1,4 +1,4 @@
-// `fibscope render --pipeline svo-straight` as a user meets it: a small
+// `fibscope render --pipeline svo-straight | svo-curved` as a user meets it: a small
 // phantom rendered as octree-traced straight tubes (the summary reports the
 // build), and one-line errors with exit code 2 for a bad radius or voxel
 // size. Validation layers on. Skipped without a Vulkan device.
@@ -39,6 +39,38 @@ TEST_F(GpuCliSvo, renderDrawsThePhantomAsOctreeTracedTubes) {
   for (size_t i = 0; i < pa.rgba.size(); i += 4)
     changed += pa.rgba[i] != pb.rgba[i] || pa.rgba[i + 1] != pb.rgba[i + 1] || pa.rgba[i + 2] != pb.rgba[i + 2];
   EXPECT_GT(changed, 200u) << changed;
+}
+
+// svo-curved: the same small phantom as sphere-traced curved tubes, at a
+// coarse step (few points a fiber, so the curves bow away from the
+// straight capsules): it draws tubes, reports the build, and its picture
+// differs from svo-straight's.
+TEST_F(GpuCliSvo, renderDrawsThePhantomAsCurvedOctreeTubes) {
+  const std::string common = "render --validate --phantom-streamlines 12 --size 96x72 --view axial --no-ssao -o ";
+  const std::string lines = dir_.file("lines.png"), straight = dir_.file("straight.png"), curved = dir_.file("curved.png");
+  const auto a = runFibscope(common + lines);
+  ASSERT_EQ(a.exit_code, 0) << a.output;
+  const std::string tube = " --tube-radius 1.5 --voxel 0.75";
+  const auto b = runFibscope(common + straight + " --pipeline svo-straight" + tube);
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  const auto c = runFibscope(common + curved + " --pipeline svo-curved" + tube);
+  ASSERT_EQ(c.exit_code, 0) << c.output;
+  EXPECT_NE(c.output.find("svo: "), std::string::npos) << c.output;
+  EXPECT_NE(c.output.find("trace"), std::string::npos) << c.output;
+  const test::Png pa = test::readOurPng(lines), pb = test::readOurPng(straight), pc = test::readOurPng(curved);
+  ASSERT_EQ(pa.rgba.size(), pc.rgba.size());
+  ASSERT_EQ(pb.rgba.size(), pc.rgba.size());
+  const auto differ = [](const test::Png& x, const test::Png& y) {
+    size_t n = 0;
+    for (size_t i = 0; i < x.rgba.size(); i += 4)
+      n += x.rgba[i] != y.rgba[i] || x.rgba[i + 1] != y.rgba[i + 1] || x.rgba[i + 2] != y.rgba[i + 2];
+    return n;
+  };
+  EXPECT_GT(differ(pa, pc), 200u);
+  EXPECT_GT(differ(pb, pc), 0u);
+  // --voxel is for the SVO pipelines only.
+  const auto d = runFibscope(common + dir_.file("x.png") + " --voxel 0.5");
+  EXPECT_EQ(d.exit_code, 2) << d.output;
 }
 
 TEST_F(GpuCliSvo, badRadiusOrVoxelIsOneLineAndExitCode2) {

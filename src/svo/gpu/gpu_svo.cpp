@@ -201,6 +201,7 @@ std::vector<SvoLeaf> voxelizeSvoLeavesGpu(const gpu::VulkanContext& context, con
         vp.slab_depth = depth;
         vp.segment_count = tubes.segment_count;
         vp.band = grid.band();
+        vp.curved = grid.curved ? 1u : 0u;
         const gpu::DispatchGrid g = gpu::dispatchGrid(context, tubes.segment_count);
         gpu::recordDispatch(cmd, voxelize, vp, g.x, g.y);
         gpu::computeToComputeBarrier(cmd);

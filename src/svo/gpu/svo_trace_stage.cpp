@@ -1,4 +1,5 @@
-// Surfaces: the SVO's straight streamtubes ray-traced by compute
+// Surfaces: the SVO's straight streamtubes ray-traced (or its curved ones
+// sphere-traced) by compute
 // (svo_trace.comp), into the surface target like every surface pass.
 #include "gpu/compute_pipeline.h"
 #include "gpu/pass_scope.h"
@@ -38,6 +39,7 @@ class SvoTraceStage final : public FrameStage {
     push.levels = svo_->grid.levels;
     push.width = width;
     push.height = height;
+    push.curved = svo_->grid.curved ? 1u : 0u;
     gpu::recordDispatch(frame.cmd, trace_, push, (width + shader::kSvoTraceTile - 1) / shader::kSvoTraceTile,
                         (height + shader::kSvoTraceTile - 1) / shader::kSvoTraceTile);
   }
