@@ -459,6 +459,51 @@ TEST_F(GpuSvoTrace, straightTubesAgreeWithEmbreeRoundLinearCurves) {
 #endif
 }
 
+// svo-straight beside svo-curved on the same phantom subsets, build and
+// image (FIBSCOPE_SVO_BENCH=1): the trace pass's GPU timestamps (second
+// frame), the builds' wall time. Step 2 mm, so the curves bow.
+TEST_F(GpuSvoTrace, benchmarkStraightAgainstCurvedWhenAsked) {
+  if (!std::getenv("FIBSCOPE_SVO_BENCH")) GTEST_SKIP() << "set FIBSCOPE_SVO_BENCH=1 to measure";
+  std::printf("| fibers | segments | voxel mm | grid | pipeline | leaves | references | voxelise s | build s | "
+              "trace ms |\n");
+  for (const uint64_t fibers : {50u, 200u}) {
+    PhantomOptions po;
+    po.streamlines = fibers;
+    po.step_mm = 2.0;
+    const Tractogram t = readAllStreamlines(*openPhantom(po));
+    const TubeModel model = buildTubes(t, test::svoTubeOptions(0.5f));
+    const Camera camera = test::svoCamera(t, 0.4, -1.0, 0.5, 256, 192);
+    for (const bool curved : {false, true}) {
+      const SvoGrid grid = chooseSvoGrid(model, 0.0f, curved);
+      GpuTubes tubes = uploadTubes(context(), model);
+      GpuSvo svo;
+      SvoGpuBuildStats st;
+      SvoTree tree;
+      double trace_ms = 0;
+      try {
+        tree = buildSvoGpu(context(), model, tubes, grid, {}, &st);
+        svo = uploadSvo(context(), tree);
+        FrameRenderer renderer(context(), camera.width, camera.height, {makeSetupStage, svoTraceStage(&svo, &tubes)});
+        renderer.render(camera, RenderSettings(), GpuScene());  // warm-up (pipeline creation)
+        const FrameStats frame = renderer.render(camera, RenderSettings(), GpuScene());
+        for (const PassTiming& p : frame.passes)
+          if (p.name == "svo trace") trace_ms += p.ms;
+      } catch (...) {
+        destroySvo(context(), svo);
+        destroyTubes(context(), tubes);
+        throw;
+      }
+      destroySvo(context(), svo);
+      destroyTubes(context(), tubes);
+      std::printf("| %llu | %zu | %.3f | %u^3 | %s | %zu | %zu | %.1f | %.1f | %.1f |\n",
+                  static_cast<unsigned long long>(fibers), model.segments.size(), grid.voxel, grid.side(),
+                  curved ? "svo-curved" : "svo-straight", tree.leaves, tree.references, st.voxelize_s, st.tree_s,
+                  trace_ms);
+      std::fflush(stdout);
+    }
+  }
+}
+
 // Figures for docs/BENCHMARKS.md, not a check: runs only with
 // FIBSCOPE_SVO_BENCH=1 (prints a table; nothing timed is asserted).
 // Phantom subsets at 1 mm steps, radius 0.5 mm, 256 x 192 px; the SVO's
