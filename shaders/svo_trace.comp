@@ -19,7 +19,7 @@
 // (min) of its list's curved-tube distances (glsl/svo_curve.glsl) from the
 // leaf's entry less the slack, at most kSvoSphereSteps steps, a hit where
 // the union falls below kSvoHitEpsilon * voxel before the leaf's exit plus
-// the slack. The union of the list bounds the distance to the list's
+// the slack (steps spent before it: the walk resumes there). The union of the list bounds the distance to the list's
 // surfaces from below (each distance is exact), so no step crosses one;
 // surfaces of segments not in the list do not enter the leaf. Normal: the
 // distance's gradient, p - C(u*) at the nearest point u*.
@@ -148,7 +148,10 @@ void main() {
             }
             t += f;
           }
-          t0 = max(t_exit, t0 + nudge);
+          // Steps spent before the leaf's end (a ray grazing a tube): the
+          // next walk step resumes from t in this leaf rather than skipping
+          // the untraced rest of it (which could pass through a surface).
+          t0 = best_seg == 0xFFFFFFFFu && t <= t_end ? max(t, t0 + nudge) : max(t_exit, t0 + nudge);
           break;
         }
         float leaf_best = t_exit + slack;

@@ -150,7 +150,7 @@ TEST(SvoCurve, distanceIsTheNearestPointOfTheHermiteCurve) {
       EXPECT_TRUE(glm::all(glm::greaterThanEqual(q, lo - 1e-4f)) && glm::all(glm::lessThanEqual(q, hi + 1e-4f)));
       scan.push_back(q);
     }
-    for (int n = 0; n < 20; ++n) {
+    for (int n = 0; n < 8; ++n) {
       const glm::vec3 p = 0.5f * (lo + hi) + glm::vec3(jitter(rng), jitter(rng), jitter(rng));
       double want = INFINITY;
       for (const glm::vec3& q : scan) want = std::min(want, double(glm::length(p - q)));
