@@ -41,16 +41,16 @@ TEST_F(GpuCliSvo, renderDrawsThePhantomAsOctreeTracedTubes) {
   EXPECT_GT(changed, 200u) << changed;
 }
 
-// svo-curved: the same small phantom as sphere-traced curved tubes, at a
-// coarse step (few points a fiber, so the curves bow away from the
-// straight capsules): it draws tubes, reports the build, and its picture
+// svo-curved: the same small phantom as sphere-traced curved tubes,
+// resampled to 0.1 mm tolerance (few nodes a fiber, so the curves bow away
+// from the straight capsules between the same nodes): it draws tubes, reports the build, and its picture
 // differs from svo-straight's.
 TEST_F(GpuCliSvo, renderDrawsThePhantomAsCurvedOctreeTubes) {
   const std::string common = "render --validate --phantom-streamlines 12 --size 96x72 --view axial --no-ssao -o ";
   const std::string lines = dir_.file("lines.png"), straight = dir_.file("straight.png"), curved = dir_.file("curved.png");
   const auto a = runFibscope(common + lines);
   ASSERT_EQ(a.exit_code, 0) << a.output;
-  const std::string tube = " --tube-radius 1.5 --voxel 0.75";
+  const std::string tube = " --tube-radius 1.5 --voxel 1.5 --tube-tolerance 0.1";
   const auto b = runFibscope(common + straight + " --pipeline svo-straight" + tube);
   ASSERT_EQ(b.exit_code, 0) << b.output;
   const auto c = runFibscope(common + curved + " --pipeline svo-curved" + tube);
