@@ -18,9 +18,9 @@ packages+=(libvulkan-dev glslc mesa-vulkan-drivers vulkan-validationlayers)
 # The viewer's window and panels (GLFW, Dear ImGui with its backend sources),
 # and a virtual X display for it where there is no screen.
 packages+=(libglfw3-dev libimgui-dev xvfb xauth)
-# Independent references for the tests (nibabel, MRtrix3) and the fuzzers (clang, libFuzzer).
+# Independent references for the tests (nibabel, MRtrix3, Embree for the SVO ray tracing) and the fuzzers (clang, libFuzzer).
 if [ "$mode" = test ]; then
-  packages+=(python3 python3-numpy python3-nibabel mrtrix3 clang libclang-rt-14-dev glslang-tools)
+  packages+=(python3 python3-numpy python3-nibabel mrtrix3 clang libclang-rt-14-dev glslang-tools libembree-dev)
 fi
 
 missing=()

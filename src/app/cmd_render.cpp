@@ -5,6 +5,7 @@
 // renders, and writes the image; prints where the time went.
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <future>
 #include <memory>
@@ -23,6 +24,7 @@
 #include "render/camera.h"
 #include "render/gpu/frame_renderer.h"
 #include "render/gpu/frame_stages.h"
+#include "svo/gpu/gpu_svo.h"
 #include "tubes/gpu/gpu_tubes.h"
 
 namespace fibscope {
@@ -34,7 +36,18 @@ struct RenderCommandOptions {
   std::string view;
   std::string camera;
   std::string output;
+  float voxel_mm = 0.0f;  // --voxel (svo-straight, svo-curved); 0: chosen from the data
+  bool voxel_given = false;
 };
+
+// `--pipeline svo-straight` (issue 16): the fibers of --tubes (all by
+// default) as straight streamtubes ray-traced from a sparse voxel octree,
+// over the compute pipeline's lines (each line lies inside its tube; the
+// fibers left out of --tubes stay lines). `--pipeline svo-curved`: the same
+// with each segment the tube around its cubic Hermite centre line,
+// sphere-traced in the octree's leaves.
+constexpr const char* kSvoStraight = "svo-straight";
+constexpr const char* kSvoCurved = "svo-curved";
 
 using Clock = std::chrono::steady_clock;
 double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
@@ -64,11 +77,25 @@ Camera cameraFor(const RenderCommandOptions& o, const LoadedScene& scene, uint32
   return orbitCamera(bounds, azimuth, elevation, width, height, distance);
 }
 
-void runRender(const RenderCommandOptions& o) {
+void runRender(RenderCommandOptions o) {
   const auto start = Clock::now();
   if (o.output.size() < 5 || o.output.substr(o.output.size() - 4) != ".png")
     throw Error("-o: the output must be a .png file, got '" + o.output + "'");
   if (!o.view.empty() && !o.camera.empty()) throw Error("--view and --camera: give one of them");
+  const auto pipeline = o.render.values.find("pipeline");
+  const bool svo_curved = pipeline != o.render.values.end() && pipeline->second == kSvoCurved;
+  const bool svo = svo_curved || (pipeline != o.render.values.end() && pipeline->second == kSvoStraight);
+  if (svo) {
+    o.render.values["pipeline"] = "compute";
+    if (o.tubes.fibers.empty()) o.tubes.fibers = "all";
+    // Tubes between the fiber's own points (resampling fits a Hermite
+    // curve, not a polyline; the curved tubes keep every point too, so
+    // straight and curved tubes share their nodes).
+    if (o.tubes.resample_tolerance_mm < 0.0f) o.tubes.resample_tolerance_mm = 0.0f;
+  }
+  if (o.voxel_given && !svo) throw Error("--voxel: only with --pipeline svo-straight or svo-curved");
+  if (o.voxel_given && !(o.voxel_mm > 0.0f && std::isfinite(o.voxel_mm)))
+    throw Error("--voxel: expected a voxel size > 0 mm, got " + std::to_string(o.voxel_mm));
   RenderSettings settings = renderSettingsFrom(o.render);
   const FilterCriteria criteria = criteriaFrom(o.render.criteria).criteria;  // bad specs before any work
   uint32_t width = 0, height = 0;
@@ -82,16 +109,18 @@ void runRender(const RenderCommandOptions& o) {
   // The tubes' buffers: the tube stage reads them at every frame (filled
   // below, released by `tubes_owner` before the device goes).
   GpuTubes tubes;
+  GpuSvo svo_tree;
   struct Device {
     std::unique_ptr<gpu::VulkanContext> context;
     std::unique_ptr<FrameRenderer> renderer;  // destroyed before the context
   };
-  std::future<Device> making = std::async(std::launch::async, [&o, &settings, &tubes, width, height] {
+  std::future<Device> making = std::async(std::launch::async, [&o, &settings, &tubes, &svo_tree, svo, width, height] {
     Device d;
     d.context = createRenderContext(o.render);
     d.renderer = std::make_unique<FrameRenderer>(
         *d.context, width, height,
-        o.tubes.requested() ? withTubeStage(standardFrameStages(), &tubes) : standardFrameStages());
+        svo ? withSvoStage(standardFrameStages(), &svo_tree, &tubes)
+            : (o.tubes.requested() ? withTubeStage(standardFrameStages(), &tubes) : standardFrameStages()));
     d.renderer->prepare(settings);  // this frame's shader variants
     return d;
   });
@@ -114,12 +143,14 @@ void runRender(const RenderCommandOptions& o) {
   struct TubesOwner {
     const gpu::VulkanContext& context;
     GpuTubes& tubes;
+    GpuSvo& svo;
     gpu::Buffer& selection;
     ~TubesOwner() {
       gpu::destroyBuffer(context, selection);
+      destroySvo(context, svo);
       destroyTubes(context, tubes);
     }
-  } tubes_owner{context, tubes, tube_selection};
+  } tubes_owner{context, tubes, svo_tree, tube_selection};
   GpuScene gpu_scene = scene.gpuScene();
   applyScalarColoring(context, scene.fiblets, o.render, settings, gpu_scene);
   const SceneFilter filter(context, scene, criteria, o.render.dim_dropped);
@@ -127,6 +158,8 @@ void runRender(const RenderCommandOptions& o) {
   if (settings.color == ColorMode::Scalar && !o.render.gave("scalar-range"))
     filter.distanceRange(settings.scalar_min, settings.scalar_max);  // colour by distance: its range
   TubeBuildStats tube_stats;
+  SvoGpuBuildStats svo_stats;
+  std::string svo_line;
   std::vector<uint32_t> tube_words;
   if (o.tubes.requested()) {
     std::vector<uint32_t> kept;
@@ -134,6 +167,14 @@ void runRender(const RenderCommandOptions& o) {
     const TubeModel model = loadTubeModel(o.render.input, o.render.phantom_streamlines, o.tubes, &tube_stats,
                                           filter.active() ? &kept : nullptr);
     tubes = uploadTubes(context, model);
+    if (svo) {
+      const SvoGrid grid = chooseSvoGrid(model, o.voxel_mm, svo_curved);
+      SvoGpuBuildOptions build;
+      build.progress = true;
+      const SvoTree tree = buildSvoGpu(context, model, tubes, grid, build, &svo_stats);
+      svo_tree = uploadSvo(context, tree);
+      svo_line = svoBuildSummary(model, tree, svo_stats);
+    }
     if (o.tubes.dim_rest && !o.render.dim_dropped) {
       tube_words.assign((scene.streamlines + 31) / 32, 0u);
       for (const TubeModel::Tube& t : model.tubes)
@@ -166,7 +207,12 @@ void runRender(const RenderCommandOptions& o) {
               static_cast<unsigned long long>(scene.streamlines), static_cast<unsigned long long>(scene.segments),
               o.output.c_str(), width, height, std::string(renderPipelineName(settings.pipeline)).c_str(),
               std::string(cullingModeName(settings.culling)).c_str());
-  if (o.tubes.requested()) {
+  if (svo) {
+    double trace_ms = 0;
+    for (const PassTiming& p : stats.passes)
+      if (p.name == "svo trace") trace_ms += p.ms;
+    std::printf("%s; trace %.1f ms\n", svo_line.c_str(), trace_ms);
+  } else if (o.tubes.requested()) {
     double tube_ms = 0;
     for (const PassTiming& p : stats.passes)
       if (p.name == "tube bin" || p.name == "tube raycast") tube_ms += p.ms;
@@ -199,6 +245,10 @@ void addRenderCommand(CLI::App& app) {
   o->render.defaults.orientation_labels = true;
   addRenderCliOptions(cmd, o->render);
   addTubeCliOptions(cmd, o->tubes);
+  cmd->add_option("--voxel", o->voxel_mm,
+                  "Voxel size of the octree in mm, with --pipeline svo-straight or svo-curved (default: from the tube radius "
+                  "and the step)")
+      ->each([o](const std::string&) { o->voxel_given = true; });
   cmd->add_option("--view", o->view, "sagittal | coronal | axial");
   cmd->add_option("--camera", o->camera, "AZ,EL,DIST: orbit angles in degrees and distance factor (0: framed snugly, 1: the bounding sphere fits)");
   cmd->add_option("-o,--output", o->output, "Output PNG")->required();

@@ -1,0 +1,318 @@
+#include "svo/gpu/gpu_svo.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <deque>
+#include <memory>
+#include <string>
+
+#include "core/error.h"
+#include "core/progress.h"
+#include "gpu/compute_pipeline.h"
+#include "gpu/pass_scope.h"
+#include "gpu/submit.h"
+#include "render/gpu/frame_stages.h"
+#include "shared/svo.h"
+
+namespace fibscope {
+namespace {
+
+double secondsSince(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+std::string megabytes(uint64_t bytes) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.1f MB", double(bytes) / 1e6);
+  return text;
+}
+
+// The sort's three pipelines.
+struct RadixPipelines {
+  gpu::ComputePipeline histogram, scan, scatter;
+  explicit RadixPipelines(const gpu::VulkanContext& c) : context(c) {
+    try {
+      histogram = gpu::createComputePipeline(c, "radix_histogram.comp", sizeof(shader::RadixPush));
+      scan = gpu::createComputePipeline(c, "radix_scan.comp", sizeof(shader::RadixPush));
+      scatter = gpu::createComputePipeline(c, "radix_scatter.comp", sizeof(shader::RadixPush));
+    } catch (...) {
+      destroy();
+      throw;
+    }
+  }
+  ~RadixPipelines() { destroy(); }
+  void destroy() {
+    gpu::destroyComputePipeline(context, scatter);
+    gpu::destroyComputePipeline(context, scan);
+    gpu::destroyComputePipeline(context, histogram);
+  }
+  const gpu::VulkanContext& context;
+};
+
+// Owns buffers made in one function, released in reverse order.
+struct Buffers {
+  explicit Buffers(const gpu::VulkanContext& c) : context(c) {}
+  ~Buffers() {
+    for (auto it = list.rbegin(); it != list.rend(); ++it) gpu::destroyBuffer(context, *it);
+  }
+  gpu::Buffer& make(VkDeviceSize bytes, gpu::MemoryUse use) {
+    return list.emplace_back(gpu::createBuffer(context, std::max<VkDeviceSize>(bytes, 4), use));
+  }
+  void release(gpu::Buffer& b) { gpu::destroyBuffer(context, b); }
+  const gpu::VulkanContext& context;
+  std::deque<gpu::Buffer> list;
+};
+
+// Records the sort of `count` pairs in (keys, values), using (keys2,
+// values2) and `counts` as scratch; an even number of passes, so the result
+// ends in (keys, values).
+void recordRadixSort(const gpu::VulkanContext& context, VkCommandBuffer cmd, const RadixPipelines& p,
+                     const gpu::Buffer& keys, const gpu::Buffer& values, const gpu::Buffer& keys2,
+                     const gpu::Buffer& values2, const gpu::Buffer& counts, uint32_t count, uint32_t bits) {
+  uint32_t passes = (bits + 3) / 4;
+  passes += passes % 2;
+  const uint32_t blocks = (count + shader::kRadixBlock - 1) / shader::kRadixBlock;
+  const gpu::DispatchGrid grid = gpu::dispatchGrid(context, blocks);
+  for (uint32_t pass = 0; pass < passes; ++pass) {
+    const bool even = pass % 2 == 0;
+    shader::RadixPush push{};
+    push.keys_in = even ? keys.address : keys2.address;
+    push.values_in = even ? values.address : values2.address;
+    push.keys_out = even ? keys2.address : keys.address;
+    push.values_out = even ? values2.address : values.address;
+    push.counts = counts.address;
+    push.count = count;
+    // A pass past the key's bits (the count made even) sorts by a digit
+    // that is 0 everywhere: stable, it changes nothing.
+    push.shift = std::min(4 * pass, 28u);
+    push.blocks = blocks;
+    gpu::recordDispatch(cmd, p.histogram, push, grid.x, grid.y);
+    gpu::computeToComputeBarrier(cmd);
+    gpu::recordDispatch(cmd, p.scan, push, 1);
+    gpu::computeToComputeBarrier(cmd);
+    gpu::recordDispatch(cmd, p.scatter, push, grid.x, grid.y);
+    gpu::computeToComputeBarrier(cmd);
+  }
+}
+
+uint64_t deviceLocalHeapBytes(const gpu::VulkanContext& context) {
+  const VkPhysicalDeviceMemoryProperties& m = context.memoryProperties();
+  uint64_t largest = 0;
+  for (uint32_t i = 0; i < m.memoryHeapCount; ++i)
+    if (m.memoryHeaps[i].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT) largest = std::max(largest, m.memoryHeaps[i].size);
+  return largest;
+}
+
+}  // namespace
+
+void gpuRadixSort(const gpu::VulkanContext& context, std::vector<uint32_t>& keys, std::vector<uint32_t>& values,
+                  uint32_t bits) {
+  if (keys.size() != values.size()) throw Error("radix sort: " + std::to_string(keys.size()) + " keys but " +
+                                                std::to_string(values.size()) + " values");
+  if (keys.empty()) return;
+  const uint32_t count = uint32_t(keys.size());
+  const uint32_t blocks = (count + shader::kRadixBlock - 1) / shader::kRadixBlock;
+  const RadixPipelines p(context);
+  Buffers b(context);
+  const VkDeviceSize bytes = VkDeviceSize(count) * 4;
+  gpu::Buffer& k = b.make(bytes, gpu::MemoryUse::DeviceLocal);
+  gpu::Buffer& v = b.make(bytes, gpu::MemoryUse::DeviceLocal);
+  gpu::Buffer& k2 = b.make(bytes, gpu::MemoryUse::DeviceLocal);
+  gpu::Buffer& v2 = b.make(bytes, gpu::MemoryUse::DeviceLocal);
+  gpu::Buffer& counts = b.make(VkDeviceSize(blocks) * shader::kRadixDigits * 4, gpu::MemoryUse::DeviceLocal);
+  gpu::uploadToBuffer(context, k, keys.data(), bytes);
+  gpu::uploadToBuffer(context, v, values.data(), bytes);
+  gpu::submitOnce(context, [&](VkCommandBuffer cmd) {
+    gpu::recordBarrier(cmd, gpu::kTransferToCompute);
+    recordRadixSort(context, cmd, p, k, v, k2, v2, counts, count, bits);
+  });
+  gpu::downloadFromBuffer(context, k, keys.data(), bytes);
+  gpu::downloadFromBuffer(context, v, values.data(), bytes);
+}
+
+std::vector<SvoLeaf> voxelizeSvoLeavesGpu(const gpu::VulkanContext& context, const TubeModel& model,
+                                          const GpuTubes& tubes, const SvoGrid& grid,
+                                          const SvoGpuBuildOptions& options, SvoGpuBuildStats* stats) {
+  SvoGpuBuildStats local;
+  SvoGpuBuildStats& st = stats ? *stats : local;
+  const uint64_t side = grid.side();
+  const uint64_t plane_bytes = side * side * 4;
+  const uint32_t slab_depth = uint32_t(std::clamp<uint64_t>(options.field_budget_bytes / plane_bytes, 1, side));
+  st.slab_depth = slab_depth;
+  st.slabs = uint32_t((side + slab_depth - 1) / slab_depth);
+  st.need = estimateSvoMemory(model, grid, slab_depth);
+  const uint64_t limit = options.memory_limit_bytes ? options.memory_limit_bytes : deviceLocalHeapBytes(context);
+  if (st.need.total() > limit)
+    throw Error("svo: the octree of " + std::to_string(model.segments.size()) + " segments at a voxel of " +
+                std::to_string(grid.voxel) + " mm needs about " + megabytes(st.need.total()) + " (distance slab " +
+                megabytes(st.need.field) + ", leaves " + megabytes(st.need.sort) + ", nodes " +
+                megabytes(st.need.nodes) + ", decoration " + megabytes(st.need.decoration) +
+                "), more than the device's " + megabytes(limit) + ": choose a larger voxel");
+  if (tubes.segment_count == 0) return {};
+
+  gpu::ComputePipeline voxelize, compact;
+  std::unique_ptr<RadixPipelines> radix;
+  struct Pipes {
+    const gpu::VulkanContext& c;
+    gpu::ComputePipeline& a;
+    gpu::ComputePipeline& b;
+    ~Pipes() {
+      gpu::destroyComputePipeline(c, b);
+      gpu::destroyComputePipeline(c, a);
+    }
+  } pipes{context, voxelize, compact};
+  voxelize = gpu::createComputePipeline(context, "svo_voxelize.comp", sizeof(shader::SvoVoxelizePush),
+                                        gpu::WorkgroupSize{shader::kSvoVoxelizeGroupSize});
+  compact = gpu::createComputePipeline(context, "svo_compact.comp", sizeof(shader::SvoCompactPush),
+                                       gpu::WorkgroupSize{shader::kSvoCompactGroupSize});
+  radix = std::make_unique<RadixPipelines>(context);
+
+  Buffers b(context);
+  gpu::Buffer& field = b.make(side * side * slab_depth * 4, gpu::MemoryUse::DeviceLocal);
+  gpu::Buffer& count_buffer = b.make(4, gpu::MemoryUse::DeviceLocal);
+  uint64_t capacity = std::max<uint64_t>(st.need.leaves, 1024);
+  uint32_t count = 0;
+  auto start = std::chrono::steady_clock::now();
+  for (;;) {
+    gpu::Buffer& keys = b.make(capacity * 4, gpu::MemoryUse::DeviceLocal);
+    gpu::Buffer& values = b.make(capacity * 4, gpu::MemoryUse::DeviceLocal);
+    Progress progress("voxelising", double(st.slabs), "slabs", options.progress);
+    const uint32_t fill_zero = 0;
+    gpu::uploadToBuffer(context, count_buffer, &fill_zero, 4);
+    for (uint32_t z0 = 0; z0 < side; z0 += slab_depth) {
+      const uint32_t depth = uint32_t(std::min<uint64_t>(slab_depth, side - z0));
+      gpu::submitOnce(context, [&](VkCommandBuffer cmd) {
+        // The previous slab's reads of the field before it is refilled.
+        gpu::recordBarrier(cmd, {VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, gpu::kStorageReadWrite,
+                                 VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT});
+        vkCmdFillBuffer(cmd, field.buffer, 0, VK_WHOLE_SIZE, shader::kSvoFar);
+        gpu::recordBarrier(cmd, gpu::kTransferToCompute);
+        shader::SvoVoxelizePush vp{};
+        vp.nodes = tubes.nodes.address;
+        vp.segments = tubes.segments.address;
+        vp.field = field.address;
+        vp.origin_x = grid.origin.x;
+        vp.origin_y = grid.origin.y;
+        vp.origin_z = grid.origin.z;
+        vp.voxel = grid.voxel;
+        vp.side = uint32_t(side);
+        vp.slab_z0 = z0;
+        vp.slab_depth = depth;
+        vp.segment_count = tubes.segment_count;
+        vp.band = grid.band();
+        vp.curved = grid.curved ? 1u : 0u;
+        const gpu::DispatchGrid g = gpu::dispatchGrid(context, tubes.segment_count);
+        gpu::recordDispatch(cmd, voxelize, vp, g.x, g.y);
+        gpu::computeToComputeBarrier(cmd);
+        shader::SvoCompactPush cp{};
+        cp.field = field.address;
+        cp.keys = keys.address;
+        cp.values = values.address;
+        cp.count = count_buffer.address;
+        cp.side = uint32_t(side);
+        cp.slab_z0 = z0;
+        cp.slab_depth = depth;
+        cp.capacity = uint32_t(std::min<uint64_t>(capacity, 0xFFFFFFFFu));
+        cp.band = grid.band();
+        const uint64_t voxels = side * side * depth;
+        const gpu::DispatchGrid cg =
+            gpu::dispatchGrid(context, (voxels + shader::kSvoCompactGroupSize - 1) / shader::kSvoCompactGroupSize);
+        gpu::recordDispatch(cmd, compact, cp, cg.x, cg.y);
+      });
+      progress.add(1);
+    }
+    progress.finish();
+    gpu::downloadFromBuffer(context, count_buffer, &count, 4);
+    if (count <= capacity) {
+      st.voxelize_s = secondsSince(start);
+      start = std::chrono::steady_clock::now();
+      std::vector<SvoLeaf> leaves(count);
+      if (count > 0) {
+        Progress sorting("sorting", 1, "sorts", options.progress);
+        gpu::Buffer& keys2 = b.make(VkDeviceSize(count) * 4, gpu::MemoryUse::DeviceLocal);
+        gpu::Buffer& values2 = b.make(VkDeviceSize(count) * 4, gpu::MemoryUse::DeviceLocal);
+        const uint32_t blocks = (count + shader::kRadixBlock - 1) / shader::kRadixBlock;
+        gpu::Buffer& counts = b.make(VkDeviceSize(blocks) * shader::kRadixDigits * 4, gpu::MemoryUse::DeviceLocal);
+        gpu::submitOnce(context, [&](VkCommandBuffer cmd) {
+          gpu::computeToComputeBarrier(cmd);  // the compaction's writes (earlier submissions)
+          recordRadixSort(context, cmd, *radix, keys, values, keys2, values2, counts, count, 3 * grid.levels);
+        });
+        std::vector<uint32_t> k(count), v(count);
+        gpu::downloadFromBuffer(context, keys, k.data(), size_t(count) * 4);
+        gpu::downloadFromBuffer(context, values, v.data(), size_t(count) * 4);
+        for (uint32_t i = 0; i < count; ++i) leaves[i] = {k[i], shader::uintBitsToFloat(v[i])};
+        sorting.add(1);
+        sorting.finish();
+      }
+      st.sort_s = secondsSince(start);
+      return leaves;
+    }
+    // The estimate was short: again with the exact count.
+    ++st.retries;
+    capacity = count;
+    b.release(values);
+    b.release(keys);
+  }
+}
+
+SvoTree buildSvoGpu(const gpu::VulkanContext& context, const TubeModel& model, const GpuTubes& tubes,
+                    const SvoGrid& grid, const SvoGpuBuildOptions& options, SvoGpuBuildStats* stats) {
+  SvoGpuBuildStats local;
+  SvoGpuBuildStats& st = stats ? *stats : local;
+  const std::vector<SvoLeaf> leaves = voxelizeSvoLeavesGpu(context, model, tubes, grid, options, &st);
+  const auto start = std::chrono::steady_clock::now();
+  Progress building("building", 1, "trees", options.progress);
+  SvoTree tree = buildSvoTree(model, grid, leaves);
+  building.add(1);
+  building.finish();
+  st.tree_s = secondsSince(start);
+  return tree;
+}
+
+std::string svoBuildSummary(const TubeModel& model, const SvoTree& tree, const SvoGpuBuildStats& stats) {
+  char text[512];
+  std::snprintf(text, sizeof(text),
+                "svo: %zu segments (streamline buffer %.3f MB), voxel %.3f mm, %u^3 grid in %u slabs, %zu leaves (%zu "
+                "with more than 4 segments, at most %zu), nodes %.3f MB, decoration %.3f MB; voxelise %.3f s, sort "
+                "%.3f s, build %.3f s",
+                model.segments.size(), double(model.deviceBytes()) / 1e6, tree.grid.voxel, tree.grid.side(),
+                stats.slabs, tree.leaves, tree.leaves_over_4, tree.max_segments_per_leaf,
+                double(tree.nodeBytes()) / 1e6, double(tree.decorationBytes()) / 1e6, stats.voxelize_s, stats.sort_s,
+                stats.tree_s);
+  return text;
+}
+
+GpuSvo uploadSvo(const gpu::VulkanContext& context, const SvoTree& tree) {
+  GpuSvo svo;
+  svo.grid = tree.grid;
+  try {
+    const size_t nb = std::max<size_t>(tree.nodeBytes(), 8), db = std::max<size_t>(tree.decorationBytes(), 4);
+    svo.nodes = gpu::createBuffer(context, nb, gpu::MemoryUse::DeviceLocal);
+    svo.decoration = gpu::createBuffer(context, db, gpu::MemoryUse::DeviceLocal);
+    gpu::uploadToBuffer(context, svo.nodes, tree.nodes.data(), tree.nodeBytes());
+    if (!tree.decoration.empty()) gpu::uploadToBuffer(context, svo.decoration, tree.decoration.data(), tree.decorationBytes());
+  } catch (...) {
+    destroySvo(context, svo);
+    throw;
+  }
+  return svo;
+}
+
+void destroySvo(const gpu::VulkanContext& context, GpuSvo& svo) {
+  gpu::destroyBuffer(context, svo.decoration);
+  gpu::destroyBuffer(context, svo.nodes);
+}
+
+FrameStageList withSvoStage(FrameStageList stages, const GpuSvo* svo, const GpuTubes* tubes) {
+  using Factory = std::unique_ptr<FrameStage> (*)(const gpu::VulkanContext&);
+  auto at = stages.begin();
+  for (; at != stages.end(); ++at) {
+    const Factory* f = at->target<Factory>();
+    if (f && *f == &makeSurfaceMergeStage) break;
+  }
+  stages.insert(at, svoTraceStage(svo, tubes));
+  return stages;
+}
+
+}  // namespace fibscope

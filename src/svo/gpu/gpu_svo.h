@@ -1,0 +1,74 @@
+// SVO streamtubes on the device (issue 16): the GPU radix sort, the GPU
+// voxelisation (svo_voxelize.comp, svo_compact.comp: slab by slab, so the
+// dense distance field never exceeds a budget), the build that uses them
+// (leaves from the GPU, the tree and its decoration lists by
+// buildSvoTree, the same function the CPU reference uses), the octree's
+// upload and the ray-tracing frame stage (svo_trace.comp).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "gpu/buffer.h"
+#include "gpu/vulkan_context.h"
+#include "render/gpu/frame_stage.h"
+#include "svo/svo_build.h"
+#include "tubes/gpu/gpu_tubes.h"
+
+namespace fibscope {
+
+// Sorts `keys` (only their low `bits` bits, <= 32) with `values` alongside,
+// stable, on the device: kRadixDigits-way LSD passes (histogram, scan,
+// scatter; shared/svo.h). keys.size() == values.size(). Throws Error when
+// memory runs out.
+void gpuRadixSort(const gpu::VulkanContext& context, std::vector<uint32_t>& keys, std::vector<uint32_t>& values,
+                  uint32_t bits = 32);
+
+struct SvoGpuBuildOptions {
+  uint64_t field_budget_bytes = 64ull << 20;  // the dense slab's size at most (decides the slab depth)
+  // 0: the device's largest device-local heap. The build throws before
+  // allocating anything when its estimate (estimateSvoMemory) exceeds it.
+  uint64_t memory_limit_bytes = 0;
+  bool progress = false;  // progress lines on stderr (voxelising, sorting, building)
+};
+
+struct SvoGpuBuildStats {
+  uint32_t slabs = 0;
+  uint32_t slab_depth = 0;
+  uint32_t retries = 0;  // reruns after the leaf buffer's estimate proved short
+  double voxelize_s = 0, sort_s = 0, tree_s = 0;  // wall time (host clock around each step)
+  SvoMemoryNeed need;
+};
+
+// The leaves (|f| < band) of `tubes`' capsules on `grid`, voxelised and
+// sorted on the device, in Morton order.
+std::vector<SvoLeaf> voxelizeSvoLeavesGpu(const gpu::VulkanContext& context, const TubeModel& model,
+                                          const GpuTubes& tubes, const SvoGrid& grid,
+                                          const SvoGpuBuildOptions& options = {}, SvoGpuBuildStats* stats = nullptr);
+
+// voxelizeSvoLeavesGpu then buildSvoTree. Throws Error naming the size
+// needed when the estimate exceeds the memory limit.
+SvoTree buildSvoGpu(const gpu::VulkanContext& context, const TubeModel& model, const GpuTubes& tubes,
+                    const SvoGrid& grid, const SvoGpuBuildOptions& options = {}, SvoGpuBuildStats* stats = nullptr);
+
+// One line for the command line: segments, streamline buffer, grid,
+// leaves (and those over 4 segments), nodes and decoration MB, the times.
+std::string svoBuildSummary(const TubeModel& model, const SvoTree& tree, const SvoGpuBuildStats& stats);
+
+struct GpuSvo {
+  gpu::Buffer nodes;       // SvoNode[]
+  gpu::Buffer decoration;  // uint[]
+  SvoGrid grid;
+};
+GpuSvo uploadSvo(const gpu::VulkanContext& context, const SvoTree& tree);
+void destroySvo(const gpu::VulkanContext& context, GpuSvo& svo);
+
+// Surfaces: "svo trace", the octree's straight tubes into the surface
+// target (svo_trace.comp). `svo` and `tubes` (the segments the tree's lists
+// index) are read every frame and must outlive the renderer.
+FrameStageFactory svoTraceStage(const GpuSvo* svo, const GpuTubes* tubes);
+// `stages` with the SVO stage inserted before the surface merge.
+FrameStageList withSvoStage(FrameStageList stages, const GpuSvo* svo, const GpuTubes* tubes);
+
+}  // namespace fibscope
