@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "gpu_test_context.h"
+#include "tube_test_scenes.h"
 #include "render/gpu/frame_renderer.h"
 #include "render/gpu/frame_stages.h"
 #include "render/gpu/pick.h"
@@ -29,34 +30,11 @@ namespace {
 class GpuSvoFrame : public test::GpuTest {};
 
 TEST_F(GpuSvoFrame, tubesAndLinesOccludeEachOtherAndPickingNamesTheTube) {
-  Tractogram lines;
-  for (int row = 0; row <= 12; ++row) {
-    std::vector<float> xyz;
-    for (int i = 0; i <= 60; ++i) xyz.insert(xyz.end(), {-15.0f + 0.5f * float(i), -12.0f + 2.0f * float(row), 0.0f});
-    lines.addStreamline(xyz.data(), xyz.size() / 3);
-  }
-  Tractogram tubes_in;
-  for (int k = 0; k < 3; ++k) {
-    std::vector<float> xyz;
-    for (int i = 0; i <= 10; ++i) {
-      const float y = -12.0f + 2.4f * float(i);
-      const float z = k == 0 ? 1.5f : (k == 1 ? -1.5f : 0.25f * y);  // above, below, through
-      xyz.insert(xyz.end(), {-9.0f + 9.0f * float(k) + std::sin(0.5f * y), y, z});
-    }
-    tubes_in.addStreamline(xyz.data(), xyz.size() / 3);
-  }
-  TubeBuildOptions o;
-  o.radius.radius = 0.8f;
-  const TubeModel model = buildTubes(tubes_in, o);
+  const test::LinesAndTubesScene scene = test::linesAndTubesScene(0.5f, 96, 72);
+  const Tractogram& lines = scene.lines;
+  const TubeModel model = buildTubes(scene.tubes, scene.options);
   constexpr uint32_t w = 96, h = 72;
-  Camera camera;
-  camera.eye = {0, 0, 80};
-  camera.target = {0, 0, 0};
-  camera.up = {0, 1, 0};
-  camera.width = w;
-  camera.height = h;
-  camera.near_mm = 60;
-  camera.far_mm = 100;
+  const Camera& camera = scene.camera;
   const ReferenceFrame line_ref = rasterizeReference(lines, camera, 2.0f);
   const TubeReferenceImage tube_ref = renderBruteForceCapsules(model, camera);
   std::vector<uint8_t> want_tube(size_t(w) * h), want_line(size_t(w) * h);

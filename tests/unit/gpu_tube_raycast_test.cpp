@@ -148,34 +148,11 @@ TEST_F(GpuTubeRaycast, tilesWhoseListsOverflowStillDrawEveryTube) {
 // (kGBufferSurface | kSurfaceSourceTube) are where the reference tube is
 // nearer than the reference lines, and the lines' where they are nearer.
 TEST_F(GpuTubeRaycast, tubesAndLinesOccludeEachOtherBothWaysAsTheReferences) {
-  Tractogram lines;
-  for (int row = 0; row <= 12; ++row) {
-    std::vector<float> xyz;
-    for (int i = 0; i <= 120; ++i) xyz.insert(xyz.end(), {-15.0f + 0.25f * float(i), -12.0f + 2.0f * float(row), 0.0f});
-    lines.addStreamline(xyz.data(), xyz.size() / 3);
-  }
-  Tractogram tubes_in;
-  for (int k = 0; k < 3; ++k) {
-    std::vector<float> xyz;
-    for (int i = 0; i <= 10; ++i) {
-      const float y = -12.0f + 2.4f * float(i);
-      const float z = k == 0 ? 1.5f : (k == 1 ? -1.5f : 0.25f * y);  // above, below, through
-      xyz.insert(xyz.end(), {-9.0f + 9.0f * float(k) + std::sin(0.5f * y), y, z});
-    }
-    tubes_in.addStreamline(xyz.data(), xyz.size() / 3);
-  }
-  TubeBuildOptions o;
-  o.radius.radius = 0.8f;
-  const TubeModel model = buildTubes(tubes_in, o);
+  const test::LinesAndTubesScene scene = test::linesAndTubesScene(0.25f, 128, 96);
+  const Tractogram& lines = scene.lines;
+  const TubeModel model = buildTubes(scene.tubes, scene.options);
   constexpr uint32_t w = 128, h = 96;
-  Camera camera;
-  camera.eye = {0, 0, 80};
-  camera.target = {0, 0, 0};
-  camera.up = {0, 1, 0};
-  camera.width = w;
-  camera.height = h;
-  camera.near_mm = 60;
-  camera.far_mm = 100;
+  const Camera& camera = scene.camera;
   const ReferenceFrame line_ref = rasterizeReference(lines, camera, 2.0f);
   const TubeReferenceImage tube_ref = renderReferenceTubes(model, camera, TubeReferenceMethod::Cascade);
   std::vector<uint8_t> want_tube(size_t(w) * h), want_line(size_t(w) * h);

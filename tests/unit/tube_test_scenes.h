@@ -89,4 +89,44 @@ inline std::vector<Camera> tubeSceneCameras(const TubeScene& scene, uint32_t wid
           fitCamera(b, {0.3, 0.5, 1}, {0, 1, 0}, width, height, 0.35)};
 }
 
+// Lines along x in the plane z = 0 (13 rows 2 mm apart, points
+// `line_step_mm` apart) and three wavy tubes of radius 0.8 mm along y above
+// them, below them and through them, seen from +z at 80 mm by a w x h
+// camera: the scene of the tests where tubes and lines occlude each other.
+struct LinesAndTubesScene {
+  Tractogram lines, tubes;
+  TubeBuildOptions options;
+  Camera camera;
+};
+
+inline LinesAndTubesScene linesAndTubesScene(float line_step_mm, uint32_t w, uint32_t h) {
+  LinesAndTubesScene scene;
+  const int line_points = int(std::lround(30.0f / line_step_mm));
+  for (int row = 0; row <= 12; ++row) {
+    std::vector<float> xyz;
+    for (int i = 0; i <= line_points; ++i)
+      xyz.insert(xyz.end(), {-15.0f + line_step_mm * float(i), -12.0f + 2.0f * float(row), 0.0f});
+    scene.lines.addStreamline(xyz.data(), xyz.size() / 3);
+  }
+  for (int k = 0; k < 3; ++k) {
+    std::vector<float> xyz;
+    for (int i = 0; i <= 10; ++i) {
+      const float y = -12.0f + 2.4f * float(i);
+      const float z = k == 0 ? 1.5f : (k == 1 ? -1.5f : 0.25f * y);  // above, below, through
+      xyz.insert(xyz.end(), {-9.0f + 9.0f * float(k) + std::sin(0.5f * y), y, z});
+    }
+    scene.tubes.addStreamline(xyz.data(), xyz.size() / 3);
+  }
+  scene.options.radius.radius = 0.8f;
+  Camera& camera = scene.camera;
+  camera.eye = {0, 0, 80};
+  camera.target = {0, 0, 0};
+  camera.up = {0, 1, 0};
+  camera.width = w;
+  camera.height = h;
+  camera.near_mm = 60;
+  camera.far_mm = 100;
+  return scene;
+}
+
 }  // namespace fibscope::test
