@@ -13,16 +13,8 @@
 namespace fibscope {
 
 TubeReferenceImage renderBruteForceCapsules(const TubeModel& model, const Camera& camera) {
-  TubeReferenceImage img;
-  img.width = camera.width;
-  img.height = camera.height;
-  const size_t n = size_t(camera.width) * camera.height;
-  img.depth.assign(n, 1.0f);
-  img.distance.assign(n, 0.0);
-  img.fiber.assign(n, shader::kNoFiberId);
-  img.position.assign(n, 0.0f);
-  img.normal.assign(n, glm::vec3(0.0f));
-  const std::array<double, 16> vp = viewProjectionD(camera);
+  const std::array<double, 16> vp = viewProjectionD(camera);  // validates the camera
+  TubeReferenceImage img = TubeReferenceImage::empty(camera);
   for (uint32_t py = 0; py < camera.height; ++py)
     for (uint32_t px = 0; px < camera.width; ++px) {
       glm::dvec3 o, d;

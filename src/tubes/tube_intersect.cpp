@@ -217,9 +217,7 @@ void tubePixelRay(const Camera& camera, uint32_t px, uint32_t py, glm::dvec3& or
   direction = glm::normalize(x_ndc / projection[0] * right + y_ndc / projection[5] * up - back);
 }
 
-TubeReferenceImage renderReferenceTubes(const TubeModel& model, const Camera& camera, TubeReferenceMethod method,
-                                        uint32_t brute_force_samples) {
-  const std::array<double, 16> vp = viewProjectionD(camera);  // validates the camera
+TubeReferenceImage TubeReferenceImage::empty(const Camera& camera) {
   TubeReferenceImage image;
   image.width = camera.width;
   image.height = camera.height;
@@ -229,6 +227,13 @@ TubeReferenceImage renderReferenceTubes(const TubeModel& model, const Camera& ca
   image.fiber.assign(pixels, shader::kNoFiberId);
   image.position.assign(pixels, 0.0f);
   image.normal.assign(pixels, glm::vec3(0.0f));
+  return image;
+}
+
+TubeReferenceImage renderReferenceTubes(const TubeModel& model, const Camera& camera, TubeReferenceMethod method,
+                                        uint32_t brute_force_samples) {
+  const std::array<double, 16> vp = viewProjectionD(camera);  // validates the camera
+  TubeReferenceImage image = TubeReferenceImage::empty(camera);
   std::vector<shader::TubeQuadratic> subs(model.subSegmentCount());
   // A sphere around each sub-segment: the swept spheres lie in the control
   // points' hull widened by the largest radius control. Rays that miss it

@@ -74,6 +74,8 @@ struct TubeReferenceImage {
   std::vector<float> position;   // along the fiber in points (TubeNode::point interpolated)
   std::vector<glm::vec3> normal;
   size_t covered() const;
+  // A camera-sized image with nothing hit.
+  static TubeReferenceImage empty(const Camera& camera);
 };
 enum class TubeReferenceMethod { Cascade, BruteForce };
 TubeReferenceImage renderReferenceTubes(const TubeModel& model, const Camera& camera, TubeReferenceMethod method,

@@ -459,6 +459,32 @@ TEST_F(GpuSvoTrace, straightTubesAgreeWithEmbreeRoundLinearCurves) {
 #endif
 }
 
+// The benchmarks' measurement: builds the SVO of `model` on the GPU and
+// returns the trace pass's GPU time of the second frame (the first creates
+// the pipelines).
+double buildAndTraceMs(gpu::VulkanContext& context, const TubeModel& model, const SvoGrid& grid, const Camera& camera,
+                       SvoTree& tree, SvoGpuBuildStats& st) {
+  GpuTubes tubes = uploadTubes(context, model);
+  GpuSvo svo;
+  double trace_ms = 0;
+  try {
+    tree = buildSvoGpu(context, model, tubes, grid, {}, &st);
+    svo = uploadSvo(context, tree);
+    FrameRenderer renderer(context, camera.width, camera.height, {makeSetupStage, svoTraceStage(&svo, &tubes)});
+    renderer.render(camera, RenderSettings(), GpuScene());
+    const FrameStats frame = renderer.render(camera, RenderSettings(), GpuScene());
+    for (const PassTiming& p : frame.passes)
+      if (p.name == "svo trace") trace_ms += p.ms;
+  } catch (...) {
+    destroySvo(context, svo);
+    destroyTubes(context, tubes);
+    throw;
+  }
+  destroySvo(context, svo);
+  destroyTubes(context, tubes);
+  return trace_ms;
+}
+
 // svo-straight beside svo-curved on the same phantom subsets, build and
 // image (FIBSCOPE_SVO_BENCH=1): the trace pass's GPU timestamps (second
 // frame), the builds' wall time. Step 2 mm, so the curves bow.
@@ -475,26 +501,9 @@ TEST_F(GpuSvoTrace, benchmarkStraightAgainstCurvedWhenAsked) {
     const Camera camera = test::svoCamera(t, 0.4, -1.0, 0.5, 256, 192);
     for (const bool curved : {false, true}) {
       const SvoGrid grid = chooseSvoGrid(model, 0.0f, curved);
-      GpuTubes tubes = uploadTubes(context(), model);
-      GpuSvo svo;
       SvoGpuBuildStats st;
       SvoTree tree;
-      double trace_ms = 0;
-      try {
-        tree = buildSvoGpu(context(), model, tubes, grid, {}, &st);
-        svo = uploadSvo(context(), tree);
-        FrameRenderer renderer(context(), camera.width, camera.height, {makeSetupStage, svoTraceStage(&svo, &tubes)});
-        renderer.render(camera, RenderSettings(), GpuScene());  // warm-up (pipeline creation)
-        const FrameStats frame = renderer.render(camera, RenderSettings(), GpuScene());
-        for (const PassTiming& p : frame.passes)
-          if (p.name == "svo trace") trace_ms += p.ms;
-      } catch (...) {
-        destroySvo(context(), svo);
-        destroyTubes(context(), tubes);
-        throw;
-      }
-      destroySvo(context(), svo);
-      destroyTubes(context(), tubes);
+      const double trace_ms = buildAndTraceMs(context(), model, grid, camera, tree, st);
       std::printf("| %llu | %zu | %.3f | %u^3 | %s | %zu | %zu | %.1f | %.1f | %.1f |\n",
                   static_cast<unsigned long long>(fibers), model.segments.size(), grid.voxel, grid.side(),
                   curved ? "svo-curved" : "svo-straight", tree.leaves, tree.references, st.voxelize_s, st.tree_s,
@@ -525,26 +534,9 @@ TEST_F(GpuSvoTrace, benchmarkAgainstEmbreeWhenAsked) {
     const TubeModel model = buildTubes(t, test::svoTubeOptions(0.5f));
     const SvoGrid grid = chooseSvoGrid(model, 0.0f);
     const Camera camera = test::svoCamera(t, 0.4, -1.0, 0.5, 256, 192);
-    GpuTubes tubes = uploadTubes(context(), model);
-    GpuSvo svo;
     SvoGpuBuildStats st;
     SvoTree tree;
-    double trace_ms = 0;
-    try {
-      tree = buildSvoGpu(context(), model, tubes, grid, {}, &st);
-      svo = uploadSvo(context(), tree);
-      FrameRenderer renderer(context(), camera.width, camera.height, {makeSetupStage, svoTraceStage(&svo, &tubes)});
-      renderer.render(camera, RenderSettings(), GpuScene());  // warm-up (pipeline creation)
-      const FrameStats frame = renderer.render(camera, RenderSettings(), GpuScene());
-      for (const PassTiming& p : frame.passes)
-        if (p.name == "svo trace") trace_ms += p.ms;
-    } catch (...) {
-      destroySvo(context(), svo);
-      destroyTubes(context(), tubes);
-      throw;
-    }
-    destroySvo(context(), svo);
-    destroyTubes(context(), tubes);
+    const double trace_ms = buildAndTraceMs(context(), model, grid, camera, tree, st);
     const auto e0 = Clock::now();
     traceEmbree(model, camera);
     const double embree_ms = std::chrono::duration<double, std::milli>(Clock::now() - e0).count();
