@@ -30,11 +30,11 @@ namespace {
 class GpuSvoFrame : public test::GpuTest {};
 
 TEST_F(GpuSvoFrame, tubesAndLinesOccludeEachOtherAndPickingNamesTheTube) {
-  const test::LinesAndTubesScene scene = test::linesAndTubesScene(0.5f, 96, 72);
-  const Tractogram& lines = scene.lines;
-  const TubeModel model = buildTubes(scene.tubes, scene.options);
+  const test::LinesAndTubesScene setup = test::linesAndTubesScene(0.5f, 96, 72);
+  const Tractogram& lines = setup.lines;
+  const TubeModel model = buildTubes(setup.tubes, setup.options);
   constexpr uint32_t w = 96, h = 72;
-  const Camera& camera = scene.camera;
+  const Camera& camera = setup.camera;
   const ReferenceFrame line_ref = rasterizeReference(lines, camera, 2.0f);
   const TubeReferenceImage tube_ref = renderBruteForceCapsules(model, camera);
   std::vector<uint8_t> want_tube(size_t(w) * h), want_line(size_t(w) * h);

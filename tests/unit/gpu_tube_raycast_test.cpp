@@ -148,11 +148,11 @@ TEST_F(GpuTubeRaycast, tilesWhoseListsOverflowStillDrawEveryTube) {
 // (kGBufferSurface | kSurfaceSourceTube) are where the reference tube is
 // nearer than the reference lines, and the lines' where they are nearer.
 TEST_F(GpuTubeRaycast, tubesAndLinesOccludeEachOtherBothWaysAsTheReferences) {
-  const test::LinesAndTubesScene scene = test::linesAndTubesScene(0.25f, 128, 96);
-  const Tractogram& lines = scene.lines;
-  const TubeModel model = buildTubes(scene.tubes, scene.options);
+  const test::LinesAndTubesScene setup = test::linesAndTubesScene(0.25f, 128, 96);
+  const Tractogram& lines = setup.lines;
+  const TubeModel model = buildTubes(setup.tubes, setup.options);
   constexpr uint32_t w = 128, h = 96;
-  const Camera& camera = scene.camera;
+  const Camera& camera = setup.camera;
   const ReferenceFrame line_ref = rasterizeReference(lines, camera, 2.0f);
   const TubeReferenceImage tube_ref = renderReferenceTubes(model, camera, TubeReferenceMethod::Cascade);
   std::vector<uint8_t> want_tube(size_t(w) * h), want_line(size_t(w) * h);
