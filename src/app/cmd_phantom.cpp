@@ -24,7 +24,7 @@ void addPhantomCommand(CLI::App& app) {
     bool force = false;
     std::string bundles;
     std::string tracker = "ifod1";
-    bool whole_brain = false;
+    std::string mix = "whole-brain";
     WriterOptions writer;
   };
   auto opt = std::make_shared<Options>();
@@ -46,10 +46,12 @@ void addPhantomCommand(CLI::App& app) {
       ->check(CLI::IsMember({"ifod1", "sd_stream"}));
   cmd->add_option("--bundles", opt->bundles,
                   "Bundle mix, e.g. corpus_callosum=2,u_fibers=0 (others keep their default weight)");
-  cmd->add_flag("--whole-brain", opt->whole_brain,
-                "Fill the white matter as whole-brain tracking does: the wm_* families beside the named bundles "
-                "(87 % of the fibers) and bundles 2.5 times as thick, so it occludes like tracker output; "
-                "--bundles then changes this mix");
+  cmd->add_option("--mix", opt->mix,
+                  "whole-brain: fibers throughout the white matter (the wm_* families, 87 % of them) beside the "
+                  "named bundles 2.5 times as thick, so it fills and occludes like whole-brain tracking; bundles: "
+                  "the named bundles alone, thin and well apart; --bundles then changes the mix")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"whole-brain", "bundles"}));
   cmd->add_option("--seed", opt->phantom.seed, "Random seed")->capture_default_str();
   cmd->add_option("--min-length", opt->phantom.min_length_mm, "Minimum fiber length in mm")->capture_default_str();
   cmd->add_option("--max-length", opt->phantom.max_length_mm, "Maximum fiber length in mm")->capture_default_str();
@@ -62,8 +64,8 @@ void addPhantomCommand(CLI::App& app) {
   cmd->callback([opt, jitter] {
     if (jitter->count() == 0) opt->phantom.jitter = opt->tracker == "sd_stream" ? 0.1 : 1.0;
     checkOverwrite(opt->output, opt->force);
-    if (opt->whole_brain) applyWholeBrainPhantomMix(opt->phantom);
-    // --bundles changes the whole-brain mix when both are given.
+    if (opt->mix == "bundles") applyNamedBundlesPhantomMix(opt->phantom);
+    // --bundles changes the chosen mix.
     if (!opt->bundles.empty())
       opt->phantom.bundle_weights = parsePhantomBundleMix(opt->bundles, opt->phantom.bundle_weights);
     if (isFblPath(opt->output)) {

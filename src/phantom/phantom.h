@@ -62,9 +62,16 @@ const std::array<std::string_view, kPhantomBundleCount>& phantomBundleNames();
 // Index of a bundle name, or -1 when there is none of that name.
 int phantomBundleIndex(std::string_view name);
 // Relative share of fibers per bundle used when PhantomOptions::bundle_weights
-// is empty (the corpus callosum and U-fibers dominate, as in whole-brain
-// tractography; the left arcuate is larger than the right).
+// is empty: the whole-brain mix, the white-matter families (wm_*) at 2.1,
+// 2.1 and 1.8 beside the named bundles' shares (namedBundlePhantomWeights,
+// together 1), so 87 % of the fibers fill the white matter and the phantom
+// fills and occludes like whole-brain tracking (MRtrix3 iFOD1 on
+// scripts/make_tckgen_250mb.sh's field: docs/BENCHMARKS.md, "Phantom
+// density").
 const std::array<double, kPhantomBundleCount>& defaultPhantomBundleWeights();
+// The named bundles alone (the wm_* families 0): the corpus callosum and
+// U-fibers dominate; the left arcuate is larger than the right.
+const std::array<double, kPhantomBundleCount>& namedBundlePhantomWeights();
 
 struct PhantomOptions {
   uint64_t streamlines = 10000;
@@ -88,17 +95,16 @@ struct PhantomOptions {
   // not all 0), indexed by PhantomBundle; empty = defaultPhantomBundleWeights().
   std::vector<double> bundle_weights;
   // Cross sections of the named bundles (all but the cingulum) are the
-  // anatomy table's radii times this.
-  double bundle_radius_scale = 1.0;
+  // anatomy table's radii times this: tracked bundles are 2.5 times as
+  // thick as the anatomy table's cores in the whole-brain mix.
+  double bundle_radius_scale = 2.5;
 };
 
-// The whole-brain mix: the white-matter families (wm_*) at 2.1, 2.1 and 1.8
-// beside the named bundles' default weights (87 % of the fibers), and
-// bundles 2.5 times as thick, so the phantom fills and occludes like
-// whole-brain tracking (MRtrix3 iFOD1 on scripts/make_tckgen_250mb.sh's
-// field: docs/BENCHMARKS.md, "Phantom density"). Sets bundle_weights and
-// bundle_radius_scale of `options`.
-void applyWholeBrainPhantomMix(PhantomOptions& options);
+// The named bundles alone and thin (namedBundlePhantomWeights, radius scale
+// 1): few, dense, well separated bundles, each fiber easy to tell apart;
+// the layout tests of picking, cuts and dissection aim at. Sets
+// bundle_weights and bundle_radius_scale of `options`.
+void applyNamedBundlesPhantomMix(PhantomOptions& options);
 
 // Throws Error ("phantom: <option> ...", one line) when an option is out of
 // range: step_mm outside [0.005, 10], max_angle_deg outside [1, 90],

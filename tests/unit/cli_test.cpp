@@ -8,7 +8,9 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include "io/reader.h"
 #include "io/writer.h"
+#include "phantom/phantom.h"
 #include "test_support.h"
 
 namespace fibscope {
@@ -111,6 +113,29 @@ TEST(Cli, phantomIsDeterministicAndReadable) {
   EXPECT_GT(j[0]["step_mm"]["fraction_within_1pct_of_median"].get<double>(), 0.999);
   EXPECT_GE(j[0]["length_mm"]["min"].get<double>(), 20.0 - 0.1);
   EXPECT_LE(j[0]["length_mm"]["max"].get<double>(), 250.0 + 0.1);
+}
+
+// --mix bundles is the named bundles alone: a file with the mix written in
+// its header differs from the default's, and reads back as the library
+// makes it; an unknown mix is one line, exit 2, and no file.
+TEST(Cli, phantomMixSelectsTheNamedBundlesOrTheWholeBrain) {
+  test::TempDir dir;
+  auto r = test::runFibscope("phantom " + dir.file("named.tck") + " -n 100 --seed 4 --mix bundles");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = test::runFibscope("phantom " + dir.file("whole.tck") + " -n 100 --seed 4 --mix whole-brain");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  PhantomOptions named;
+  applyNamedBundlesPhantomMix(named);
+  named.streamlines = 100;
+  named.seed = 4;
+  const Tractogram a = readAllStreamlines(*openTractogram(dir.file("named.tck")));
+  const Tractogram b = readAllStreamlines(*openPhantom(named));
+  ASSERT_EQ(a.pointCount(), b.pointCount());
+  EXPECT_EQ(a.offsets, b.offsets);
+  EXPECT_NE(test::readBytes(dir.file("named.tck")), test::readBytes(dir.file("whole.tck")));
+  r = test::runFibscope("phantom " + dir.file("bad.tck") + " -n 10 --mix fat");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("bad.tck")));
 }
 
 }  // namespace fibscope

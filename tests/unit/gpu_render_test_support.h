@@ -38,8 +38,13 @@ inline Tractogram lineTractogram(std::initializer_list<size_t> lengths) {
   return t;
 }
 
-inline Tractogram renderPhantom(uint64_t streamlines, uint64_t seed) {
+// The built-in phantom's first fibers at 0.1 mm (one thread): the default,
+// whole-brain mix, or with `named_bundles` the named bundles alone, thin and
+// apart (applyNamedBundlesPhantomMix), for tests whose views and cuts were
+// placed on that layout.
+inline Tractogram renderPhantom(uint64_t streamlines, uint64_t seed, bool named_bundles = false) {
   PhantomOptions options;
+  if (named_bundles) applyNamedBundlesPhantomMix(options);
   options.streamlines = streamlines;
   options.step_mm = 0.1;
   options.seed = seed;

@@ -98,8 +98,11 @@ class GpuDissectionViewer : public ::testing::Test {
     const auto r = test::runFibscope("gpu-info");
     if (r.exit_code != 0) GTEST_SKIP() << "no usable Vulkan device: " << r.output;
     // A small phantom, written with its header (step size) and kept here
-    // with the bundle of each fiber.
+    // with the bundle of each fiber: the named bundles alone, so the two
+    // spheres on the corticospinal tract keep its fibers only (in the
+    // whole-brain mix, projection fibers of the white matter pass them too).
     PhantomOptions options;
+    applyNamedBundlesPhantomMix(options);
     options.streamlines = 300;
     options.seed = 5;
     options.threads = 1;

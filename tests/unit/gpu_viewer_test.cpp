@@ -739,7 +739,9 @@ TEST_F(GpuViewer, scriptLoadRunsOnTheWorkerWhileFramesGoOn) {
 class GpuMultiModelViewer : public GpuViewer {};
 
 // A phantom compressed to a .fbl (opened as stored: its decode is the
-// reference the export is compared with).
+// reference the export is compared with): the named bundles alone, whose
+// gaps leave pixels where one model shows without the other (the
+// whole-brain mix covers nearly the whole view with either).
 Tractogram compressPhantom(const std::string& fbl, uint64_t seed) {
   CompressOptions options;
   options.terminal_progress = false;
@@ -747,6 +749,7 @@ Tractogram compressPhantom(const std::string& fbl, uint64_t seed) {
   compressTractogram(
       [seed] {
         PhantomOptions p;
+        applyNamedBundlesPhantomMix(p);
         p.streamlines = 300;
         p.seed = seed;
         p.threads = 1;
