@@ -39,8 +39,35 @@ struct BenchOptions {
   double elevation_deg = 0;
   double distance = 0;  // 0: the closest that frames the box at every azimuth
   uint32_t warmup = 2;
+  // 0: every frame of the orbit. N: N frames spread evenly over it, each
+  // after an unmeasured frame one step before it, so two-phase culling sees
+  // the previous frame the full orbit would have shown it; the fractions
+  // drawn estimate the full orbit's at 2N / frames of its cost.
+  uint32_t sample = 0;
   bool json = false;
 };
+
+struct OrbitFrame {
+  double azimuth_deg = 0;
+  bool measured = false;
+};
+
+// The frames rendered, in order: the warm-up at the first frame's camera,
+// then the orbit or its sample.
+std::vector<OrbitFrame> orbitFrames(const BenchOptions& o) {
+  std::vector<OrbitFrame> frames(o.warmup, OrbitFrame{0.0, false});
+  if (o.sample == 0) {
+    for (uint32_t i = 0; i < o.frames; ++i) frames.push_back({o.step_deg * double(i), true});
+    return frames;
+  }
+  for (uint32_t j = 0; j < o.sample; ++j) {
+    const uint64_t index = uint64_t(j) * o.frames / o.sample;
+    // The orbit's first frame follows the warm-up at its own camera.
+    frames.push_back({o.step_deg * (index == 0 ? 0.0 : double(index) - 1.0), false});
+    frames.push_back({o.step_deg * double(index), true});
+  }
+  return frames;
+}
 
 struct Variant {
   std::string label;  // "compute/two-phase"
@@ -96,6 +123,7 @@ double mean(const std::vector<double>& values) {
 void runBench(const BenchOptions& o) {
   if (o.frames < 1 || o.frames > 100000) throw Error("--frames: expected 1 to 100000");
   if (!(std::fabs(o.step_deg) <= 360)) throw Error("--step: expected degrees in [-360, 360]");
+  if (o.sample > o.frames) throw Error("--sample: expected at most --frames (" + std::to_string(o.frames) + ")");
   std::vector<Variant> variants = variantsFrom(o);
   const FilterCriteria criteria = criteriaFrom(o.render.criteria).criteria;  // bad specs before any work
   uint32_t width = 0, height = 0;
@@ -148,18 +176,17 @@ void runBench(const BenchOptions& o) {
     }
   }
   out["distance_factor"] = distance;
-  const uint32_t total = o.warmup + o.frames;
-  for (uint32_t frame = 0; frame < total; ++frame) {
-    // Warm-up frames run at the first frame's camera.
-    const double azimuth = o.step_deg * double(frame < o.warmup ? 0 : frame - o.warmup);
-    const Camera camera =
-        withAnatomyInView(orbitCamera(scene.bounds, azimuth, o.elevation_deg, width, height, distance), anatomy);
+  const std::vector<OrbitFrame> frames = orbitFrames(o);
+  const uint32_t measured = o.sample == 0 ? o.frames : o.sample;
+  for (const OrbitFrame& frame : frames) {
+    const Camera camera = withAnatomyInView(
+        orbitCamera(scene.bounds, frame.azimuth_deg, o.elevation_deg, width, height, distance), anatomy);
     for (size_t i = 0; i < variants.size(); ++i) {
       Variant& v = variants[i];
       const auto t0 = std::chrono::steady_clock::now();
       const FrameStats stats = renderers[i]->render(camera, v.settings, variant_scenes[i]);
       const double wall = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-      if (frame < o.warmup) continue;
+      if (!frame.measured) continue;
       v.gpu_ms.push_back(stats.gpu_ms);
       v.wall_ms.push_back(wall);
       const double total_fiblets = double(std::max<uint64_t>(stats.fiblets_total, 1));
@@ -184,7 +211,8 @@ void runBench(const BenchOptions& o) {
   out["device"] = context->info().name;
   out["driver"] = context->info().driver_name + " " + context->info().driver_info;
   out["size"] = {width, height};
-  out["frames"] = o.frames;
+  out["frames"] = measured;
+  if (o.sample != 0) out["sampled_from_frames"] = o.frames;
   out["step_deg"] = o.step_deg;
   out["streamlines"] = scene.streamlines;
   out["segments"] = scene.segments;
@@ -204,10 +232,11 @@ void runBench(const BenchOptions& o) {
   const double base_median = ratioTime(variants.front());
   out["ratio_basis"] = cpu_device ? "median wall ms (CPU device)" : "median GPU ms";
   if (!o.json) {
-    std::printf("%s: %llu streamlines, %llu segments, %u fiblets; %u frames at %.2f deg/frame, %ux%u, %s\n",
-                scene.name.c_str(), static_cast<unsigned long long>(scene.streamlines),
-                static_cast<unsigned long long>(scene.segments), scene.fiblets.block().fiblet_count, o.frames,
-                o.step_deg, width, height, context->info().name.c_str());
+    std::printf("%s: %llu streamlines, %llu segments, %u fiblets; %u frames at %.2f deg/frame", scene.name.c_str(),
+                static_cast<unsigned long long>(scene.streamlines), static_cast<unsigned long long>(scene.segments),
+                scene.fiblets.block().fiblet_count, measured, o.step_deg);
+    if (o.sample != 0) std::printf(" (sampled from an orbit of %u)", o.frames);
+    std::printf(", %ux%u, %s\n", width, height, context->info().name.c_str());
     if (cpu_device)
       std::printf("note: CPU device: ratios use wall time (per-pass timestamps of large dispatches are unreliable "
                   "on lavapipe)\n");
@@ -229,11 +258,12 @@ void runBench(const BenchOptions& o) {
     if (fiblets) {
       j["fiblets_drawn_fraction"] = mean(v.drawn_fraction);
       j["fiblets_lod_fraction"] = mean(v.lod_fraction);
+      j["fiblets_drawn_fraction_per_frame"] = v.drawn_fraction;
     }
     j["segments_drawn_per_ms"] = segments_per_ms;
     j["wall_median_ms"] = percentile(v.wall_ms, 50);
     j["median_ratio_to_first"] = base_median > 0 ? ratioTime(v) / base_median : 0.0;
-    for (const std::string& name : v.pass_order) j["pass_mean_ms"][name] = v.pass_ms_sum[name] / double(o.frames);
+    for (const std::string& name : v.pass_order) j["pass_mean_ms"][name] = v.pass_ms_sum[name] / double(measured);
     if (!o.json) {
       std::printf("%-20s %10.3f %10.3f %10.3f %10.3f", v.label.c_str(), mean(v.gpu_ms), median,
                   percentile(v.gpu_ms, 95), mean(v.wall_ms));
@@ -243,7 +273,7 @@ void runBench(const BenchOptions& o) {
       if (variants.size() > 1) std::printf("   x%.2f of %s", base_median > 0 ? ratioTime(v) / base_median : 0.0,
                                            variants.front().label.c_str());
       std::printf("\n    passes:");
-      for (const std::string& name : v.pass_order) std::printf(" %s %.3f", name.c_str(), v.pass_ms_sum[name] / double(o.frames));
+      for (const std::string& name : v.pass_order) std::printf(" %s %.3f", name.c_str(), v.pass_ms_sum[name] / double(measured));
       std::printf(" (mean ms)\n");
     }
     out["results"].push_back(j);
@@ -265,6 +295,10 @@ void addBenchCommand(CLI::App& app) {
   cmd->add_option("--elevation", o->elevation_deg, "Orbit elevation, degrees")->capture_default_str();
   cmd->add_option("--distance", o->distance, "Camera distance factor (1: the bounding sphere fits; 0: as close as frames the tractogram all around)")->capture_default_str();
   cmd->add_option("--warmup", o->warmup, "Unmeasured frames first")->capture_default_str();
+  cmd->add_option("--sample", o->sample,
+                  "Measure N frames spread evenly over the orbit, each after the frame one step before it "
+                  "(0: every frame)")
+      ->capture_default_str();
   cmd->add_flag("--json", o->json, "Print the results as JSON");
   cmd->callback([o] { runBench(*o); });
 }

@@ -245,5 +245,29 @@ TEST_F(GpuCliRender, benchReportsTheOrbitAsJson) {
   EXPECT_EQ(json["results"][1]["fiblets_drawn_fraction"].get<double>(), 1.0) << "no culling draws every fiblet";
 }
 
+// --sample measures frames spread over the orbit, each after the frame one
+// step before it: two-phase culling then draws on each exactly what it
+// draws on that frame of the full orbit (its previous frame is the same),
+// so the sampled fractions are the full orbit's at those frames.
+TEST_F(GpuCliRender, benchSampleDrawsWhatTheFullOrbitDrawsOnTheSameFrames) {
+  auto fractions = [&](const std::string& extra) {
+    const auto r = runGpuFibscope("bench --validate --json --phantom-streamlines 300 --size 160x96 --frames 6 "
+                                  "--step 20 --warmup 1 --compare compute/two-phase " + extra);
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    if (r.exit_code != 0) return std::vector<double>{};
+    const auto json = nlohmann::json::parse(r.output.substr(r.output.find('{')));
+    return json["results"][0]["fiblets_drawn_fraction_per_frame"].get<std::vector<double>>();
+  };
+  const std::vector<double> full = fractions(""), sampled = fractions("--sample 3");
+  ASSERT_EQ(full.size(), 6u);
+  ASSERT_EQ(sampled.size(), 3u);
+  for (size_t j = 0; j < 3; ++j) EXPECT_EQ(sampled[j], full[2 * j]) << "sampled frame " << j;
+  // Occlusion culls something on some frame, or the test shows nothing.
+  EXPECT_LT(*std::min_element(full.begin(), full.end()), 1.0);
+  const auto bad = runGpuFibscope("bench --phantom-streamlines 50 --frames 4 --sample 5");
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_EQ(lineCount(bad.output), 1) << bad.output;
+}
+
 }  // namespace
 }  // namespace fibscope
