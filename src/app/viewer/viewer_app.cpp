@@ -347,7 +347,8 @@ void ViewerApp::createFrameObjects() {
   ModelLoaderOptions loader_options;
   loader_options.phantom_streamlines = options_.phantom_streamlines;
   loader_ = std::make_unique<ModelLoader>(loader_options);
-  bundling_ = std::make_unique<ViewerBundling>(options_.device);
+  bundling_ = std::make_unique<ViewerBundling>(
+      options_.device, options_.validate ? context_->instance().sharedLog() : std::shared_ptr<gpu::DebugLog>{});
   // Loaded on the worker while frames are drawn; a file that cannot be
   // read shows its error (pollLoads; offscreen, one named on the command
   // line ends the run).

@@ -33,7 +33,8 @@ std::string bundledFileName(const std::string& name, uint64_t job) {
 
 }  // namespace
 
-ViewerBundling::ViewerBundling(std::string device_name) : device_name_(std::move(device_name)) {}
+ViewerBundling::ViewerBundling(std::string device_name, std::shared_ptr<gpu::DebugLog> validation_log)
+    : device_name_(std::move(device_name)), validation_log_(std::move(validation_log)) {}
 
 ViewerBundling::~ViewerBundling() {
   cancel();
@@ -134,6 +135,8 @@ void ViewerBundling::run(ViewerBundleSource source, BundleParams params) {
     // A context of its own: the viewer's is the main thread's.
     gpu::ContextOptions context_options;
     context_options.device_name = device_name_;
+    context_options.instance.validation = validation_log_ != nullptr;
+    context_options.instance.log = validation_log_;
     const gpu::VulkanContext context(context_options);
     Progress progress("bundling", double(params.iterations), "iterations", /*terminal=*/false, sink);
     std::vector<float> moved;

@@ -26,6 +26,7 @@
 
 #include "bundling/bundle_params.h"
 #include "core/progress.h"
+#include "gpu/vulkan_instance.h"
 
 namespace fibscope {
 
@@ -51,7 +52,10 @@ struct ViewerBundleResult {
 class ViewerBundling {
  public:
   // `device_name`: as the viewer's --device (empty: the best device).
-  explicit ViewerBundling(std::string device_name = {});
+  // `validation_log`: non-null with the viewer's --validate: the worker's
+  // context turns the validation layers on and files their messages there,
+  // so the viewer's end-of-run check counts them with its own.
+  explicit ViewerBundling(std::string device_name = {}, std::shared_ptr<gpu::DebugLog> validation_log = {});
   // Cancels a running job, joins the worker, removes the temporary files.
   ~ViewerBundling();
   ViewerBundling(const ViewerBundling&) = delete;
@@ -76,6 +80,7 @@ class ViewerBundling {
   void report(const ProgressSnapshot& snapshot);
 
   std::string device_name_;
+  std::shared_ptr<gpu::DebugLog> validation_log_;
   std::string temp_dir_;  // created at the first job
   std::vector<std::string> temp_files_;
   uint64_t jobs_ = 0;
