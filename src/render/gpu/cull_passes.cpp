@@ -286,6 +286,31 @@ void recordCulledRaster(VkCommandBuffer cmd, const gpu::VulkanContext& context, 
   buffers.history_scene = scene;
 }
 
+void recordCullLists(VkCommandBuffer cmd, const gpu::VulkanContext& context, const CullPasses& passes,
+                     const SceneLayout& scene, const GpuFrameTargets& frame, CullBuffers& buffers,
+                     const CullFrame& cull) {
+  if (scene.entries.size() != buffers.regions.size())
+    throw Error("cull: the buffers were prepared for " + std::to_string(buffers.regions.size()) +
+                " datasets, the scene has " + std::to_string(scene.entries.size()));
+  if (cull.mode == CullingMode::TwoPhase || cull.lod_pixels != 0.0f)
+    throw Error("cull: the list-only cull is Frustum or None without LoD");
+  computeToTransfer(cmd);
+  vkCmdFillBuffer(cmd, buffers.stats.buffer, 0, VK_WHOLE_SIZE, 0);
+  resetLists(cmd, buffers);
+  gpu::recordBarrier(cmd, gpu::kTransferToCompute);
+  const uint32_t mode = cull.mode == CullingMode::Frustum ? shader::kCullFrustum : shader::kCullKeptOnly;
+  for (size_t i = 0; i < scene.entries.size(); ++i)
+    recordCull(cmd, context, passes, scene.entries[i], buffers.regions[i], frame, buffers, mode, cull);
+  gpu::computeToComputeBarrier(cmd);
+  buffers.history_valid = false;
+}
+
+void recordCullListStats(VkCommandBuffer cmd, const CullBuffers& buffers) {
+  copyCounts(cmd, buffers, 0);
+  gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                     VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+}
+
 CullStats readCullStats(const gpu::VulkanContext& context, const CullBuffers& buffers) {
   CullStats stats;
   if (!buffers.stats.buffer || buffers.regions.empty()) return stats;

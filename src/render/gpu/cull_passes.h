@@ -130,6 +130,21 @@ void recordCulledRaster(VkCommandBuffer cmd, const gpu::VulkanContext& context, 
                         const FibletPasses& fiblet_passes, const SceneLayout& scene, const GpuFrameTargets& frame,
                         CullBuffers& buffers, const CullFrame& cull, gpu::GpuTimer* timer);
 
+// The cull alone, for pipelines that draw its lists themselves (the
+// geometry and tessellation fiblet pipelines, which turn each region's
+// full-detail list into an indirect draw): every region's counters reset,
+// then every dataset's cull in `cull.mode` (Frustum or None, the fiber
+// filter only; the lists' writes visible to later compute passes when it
+// returns). LoD goes to the LoD list, which these pipelines do not draw:
+// cull.lod_pixels must be 0. The two-phase history is invalidated.
+void recordCullLists(VkCommandBuffer cmd, const gpu::VulkanContext& context, const CullPasses& passes,
+                     const SceneLayout& scene, const GpuFrameTargets& frame, CullBuffers& buffers,
+                     const CullFrame& cull);
+// After recordCullLists and the draws that read its lists (their reads
+// before this with a barrier of the caller's): the counts copied for
+// readCullStats.
+void recordCullListStats(VkCommandBuffer cmd, const CullBuffers& buffers);
+
 // The fiblets drawn by the last recorded frame (summed over its datasets),
 // once it has completed.
 struct CullStats {
