@@ -19,9 +19,6 @@ constexpr uint32_t kGeometryVertices = shader::kFibletMaxPoints + 1;  // + the j
 // Per geometry output vertex: gl_Position, the clip distances and the three
 // flat words, counted as a driver may (built-ins included).
 constexpr uint32_t kGeometryComponents = 4 + shader::kMaxFrameClipPlanes + 3;
-constexpr uint32_t kTessLanes = 32;                 // output patch size
-constexpr uint32_t kTessVertexComponents = 6 * 4;   // six vec3 outputs, a location each
-constexpr uint32_t kTessPatchComponents = 3 * 4;    // three per-patch outputs
 constexpr uint32_t kTessSegments = shader::kFibletMaxPoints;  // used + the joining segment
 
 std::string refusal(const gpu::VulkanContext& context, RenderPipeline kind, const std::string& why) {
@@ -44,14 +41,8 @@ void checkDevice(const gpu::VulkanContext& context, RenderPipeline kind) {
                           std::to_string(kGeometryVertices * kGeometryComponents) + " geometry output components"));
   } else {
     if (!f.tessellationShader) throw Error(refusal(context, kind, "tessellation shaders (tessellationShader)"));
-    if (l.maxTessellationPatchSize < kTessLanes)
-      throw Error(refusal(context, kind, std::to_string(kTessLanes) + "-vertex patches"));
     if (l.maxTessellationGenerationLevel < kTessSegments)
       throw Error(refusal(context, kind, "tessellation level " + std::to_string(kTessSegments)));
-    if (l.maxTessellationControlPerVertexOutputComponents < kTessVertexComponents ||
-        l.maxTessellationControlTotalOutputComponents < kTessLanes * kTessVertexComponents + kTessPatchComponents ||
-        l.maxTessellationEvaluationInputComponents < kTessVertexComponents)
-      throw Error(refusal(context, kind, "the tessellation control outputs of a 32-lane decode"));
   }
 }
 

@@ -9,9 +9,10 @@
 //                 the geometry shader decodes serially and emits a line
 //                 strip of up to 61 vertices.
 //   tessellation: fiblet_lines.vert + .tesc + .tese + .frag: one-vertex
-//                 patches, the control stage decodes with a 32-lane
-//                 parallel prefix, the tessellator makes one isoline of up
-//                 to 60 segments.
+//                 patches, the tessellator makes one isoline of up to 60
+//                 segments per fiblet, the evaluation stage decodes each
+//                 vertex's point from the fiblet's start (why: the shaders'
+//                 headers).
 // One draw per dataset: vkCmdDraw of every fiblet, or, culled, one
 // vkCmdDrawIndirect per dataset whose arguments fiblet_draw_args.comp
 // writes from the cull list's count (the vertex shader reads the list).
@@ -46,8 +47,8 @@ struct FibletGraphicsPass {
 // The pipeline of `kind` (Geometry or Tessellation). Throws Error (one
 // line) when the device lacks a graphics queue, the stage's feature
 // (geometryShader, tessellationShader), gl_ClipDistance, or the limits the
-// shaders need (61 geometry output vertices and their components; 32-vertex
-// output patches of 24 components a vertex, 60 tessellation segments).
+// shaders need (61 geometry output vertices and their components; a
+// tessellation level of 60).
 FibletGraphicsPass createFibletGraphicsPass(const gpu::VulkanContext& context, RenderPipeline kind);
 void destroyFibletGraphicsPass(const gpu::VulkanContext& context, FibletGraphicsPass& pass);
 
