@@ -71,14 +71,7 @@ std::vector<Variant> variantsFrom(const BenchOptions& o) {
     v.settings = base;
     const size_t slash = spec.find('/');
     v.settings.pipeline = parseRenderPipeline(spec.substr(0, slash));
-    if (slash != std::string::npos) {
-      v.settings.culling = parseCullingMode(spec.substr(slash + 1));
-    } else if (v.settings.pipeline != RenderPipeline::Compute && drawsFiblets(v.settings.pipeline) &&
-               v.settings.culling == CullingMode::TwoPhase) {
-      // The graphics fiblet pipelines cull with none or frustum: a bare
-      // "geometry" takes frustum (the label says so).
-      v.settings.culling = CullingMode::Frustum;
-    }
+    if (slash != std::string::npos) v.settings.culling = parseCullingMode(spec.substr(slash + 1));
     v.label = std::string(renderPipelineName(v.settings.pipeline));
     if (drawsFiblets(v.settings.pipeline)) v.label += "/" + std::string(cullingModeName(v.settings.culling));
     variants.push_back(std::move(v));

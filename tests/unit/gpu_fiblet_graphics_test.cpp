@@ -14,9 +14,9 @@
 //     where the fiber is the same, segment and tangent (the G-buffer
 //     picking reads) mostly the same;
 //   - each other (the same points to float rounding);
-//   - culling none against frustum (the same coverage; frustum culls when
-//     zoomed in), two-phase refused in one line, filtered fibers not drawn,
-//     two models drawn with the scene's fiber numbering;
+//   - culling none against frustum and two-phase (the same coverage over
+//     an orbit, a jump and a zoom; something culled), filtered fibers not
+//     drawn, two models drawn with the scene's fiber numbering;
 //   - the command line: a PNG from each, and one-line errors (exit 2).
 // Validation layers on (GpuTest fails on any message). Skipped where the
 // device lacks the stage (never on lavapipe).
@@ -274,40 +274,44 @@ TEST_F(GpuFibletGraphics, DISABLED_tessellationIdsAgreeWithTheComputePipeline) {
   agreesWithTheComputePipeline(RenderPipeline::Tessellation);
 }
 
-TEST_F(GpuFibletGraphics, frustumCullingKeepsTheCoverageAndTwoPhaseIsRefused) {
-  FrameRenderer renderer(context(), kSize, kSize);
-  const View views[] = {views_[3], {"zoomed", orbitCamera(bounds_, 120, 10, kSize, kSize, 0.25)}};
-  for (RenderPipeline pipeline : kBothPipelines) {
-    // (Tessellation: only the refusal, see the file's header.)
-    const bool draws = pipeline == RenderPipeline::Geometry;
-    bool culled_some = !draws;
+TEST_F(GpuFibletGraphics, frustumAndTwoPhaseCullingKeepTheCoverageOfDrawingEveryFiblet) {
+  FrameRenderer reference(context(), kSize, kSize), culled(context(), kSize, kSize);
+  // An orbit of a few frames (two-phase learns from the last), a jump and a
+  // zoom in (the frustum culls part of the phantom).
+  const View views[] = {{"orbit 0", orbitCamera(bounds_, 30, 20, kSize, kSize, 1.0)},
+                        {"orbit 1", orbitCamera(bounds_, 31.14, 20, kSize, kSize, 1.0)},
+                        {"orbit 2", orbitCamera(bounds_, 32.28, 20, kSize, kSize, 1.0)},
+                        {"jump", orbitCamera(bounds_, 92.28, 20, kSize, kSize, 1.0)},
+                        {"zoomed", orbitCamera(bounds_, 93.42, 20, kSize, kSize, 0.25)}};
+  const RenderPipeline pipeline = RenderPipeline::Geometry;  // (tessellation: see the file's header)
+  for (CullingMode mode : {CullingMode::Frustum, CullingMode::TwoPhase}) {
+    bool culled_some = false;
     for (const View& view : views) {
-      if (!draws) break;
-      SCOPED_TRACE(nameOf(pipeline) + " " + view.name);
-      FrameStats none_stats, frustum_stats;
-      const auto none = render(renderer, view.camera, plainSettings(pipeline, CullingMode::None, 2.0f),
+      SCOPED_TRACE(std::string(cullingModeName(mode)) + " " + view.name);
+      FrameStats none_stats, stats;
+      const auto none = render(reference, view.camera, plainSettings(pipeline, CullingMode::None, 2.0f),
                                GpuScene{&dataset()}, &none_stats);
-      const auto frustum = render(renderer, view.camera, plainSettings(pipeline, CullingMode::Frustum, 2.0f),
-                                  GpuScene{&dataset()}, &frustum_stats);
-      const CoverageComparison c = compareCoverage(gbufferMask(none), gbufferMask(frustum), kSize, kSize);
-      std::printf("[ GPU      ] %s %s none vs frustum: %s; drawn %llu of %llu\n", nameOf(pipeline).c_str(), view.name,
-                  c.summary().c_str(), (unsigned long long)frustum_stats.fiblets_drawn,
-                  (unsigned long long)frustum_stats.fiblets_total);
+      const auto drawn =
+          render(culled, view.camera, plainSettings(pipeline, mode, 2.0f), GpuScene{&dataset()}, &stats);
+      const CoverageComparison c = compareCoverage(gbufferMask(none), gbufferMask(drawn), kSize, kSize);
+      size_t fiber_diff = 0;
+      for (size_t i = 0; i < none.size(); ++i)
+        fiber_diff += none[i].fiber != shader::kNoFiberId && drawn[i].fiber != shader::kNoFiberId &&
+                      none[i].fiber != drawn[i].fiber;
+      std::printf("[ GPU      ] geometry %s %s: %s; other fiber %zu; drawn %llu of %llu\n", cullingModeName(mode).data(),
+                  view.name, c.summary().c_str(), fiber_diff, (unsigned long long)stats.fiblets_drawn,
+                  (unsigned long long)stats.fiblets_total);
       ASSERT_GT(c.covered_a, 0u);
+      // Culling is conservative: the same pixels. (Fibers may differ only
+      // at depth ties, the draw order being the lists'.)
       EXPECT_EQ(c.covered_a, c.covered_b) << c.summary();
       EXPECT_EQ(c.covered_both, c.covered_a) << c.summary();
+      EXPECT_LE(fiber_diff, c.covered_a / 100);
       EXPECT_EQ(none_stats.fiblets_drawn, none_stats.fiblets_total);
-      EXPECT_EQ(frustum_stats.fiblets_lod, 0u);  // no LoD in these pipelines
-      culled_some |= frustum_stats.fiblets_drawn < frustum_stats.fiblets_total;
+      EXPECT_EQ(stats.fiblets_lod, 0u);  // no LoD in these pipelines
+      culled_some |= stats.fiblets_drawn < stats.fiblets_total;
     }
-    EXPECT_TRUE(culled_some) << "zoomed in, the frustum culls some fiblets";
-    try {
-      renderer.render(views[0].camera, plainSettings(pipeline, CullingMode::TwoPhase, 2.0f), GpuScene{&dataset()});
-      ADD_FAILURE() << "two-phase culling was accepted";
-    } catch (const Error& e) {
-      EXPECT_NE(std::string(e.what()).find("two-phase"), std::string::npos) << e.what();
-      EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
-    }
+    EXPECT_TRUE(culled_some) << "something is culled";
   }
 }
 
@@ -378,11 +382,6 @@ TEST_F(GpuCliFibletGraphics, renderDrawsEachPipelineToAPngAndRefusesBadNamesInOn
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_NE(r.output.find(std::string(pipeline) + " pipeline"), std::string::npos) << r.output;
     EXPECT_GT(test::readBytes(png).size(), 100u);
-    const auto two_phase = test::runCommand(std::string(FIBSCOPE_EXE) +
-                                            " render --phantom-streamlines 100 --size 64x48 --pipeline " + pipeline +
-                                            " --culling two-phase -o " + dir_.file("no.png"));
-    EXPECT_EQ(two_phase.exit_code, 2) << two_phase.output;
-    EXPECT_EQ(lineCount(two_phase.output), 1) << two_phase.output;
   }
   const auto bad = test::runCommand(std::string(FIBSCOPE_EXE) +
                                     " render --phantom-streamlines 100 --size 64x48 --pipeline geometri -o " +

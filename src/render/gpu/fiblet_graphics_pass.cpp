@@ -114,11 +114,14 @@ void recordFibletDrawArgs(VkCommandBuffer cmd, const FibletGraphicsPass& pass, c
 
 void recordFibletGraphics(VkCommandBuffer cmd, const gpu::VulkanContext& context, FibletGraphicsPass& pass,
                           const SceneLayout& scene, const GpuFrameTargets& frame, const CullBuffers* culled,
-                          float line_width_px) {
+                          float line_width_px, bool resume) {
   if (culled && culled->regions.size() != scene.entries.size())
     throw Error("render: the cull lists were prepared for " + std::to_string(culled->regions.size()) +
                 " datasets, the scene has " + std::to_string(scene.entries.size()));
-  beginLineAttachments(cmd, pass.attachments);
+  if (resume)
+    resumeLineAttachments(cmd, pass.attachments);
+  else
+    beginLineAttachments(cmd, pass.attachments);
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pass.pipeline.pipeline);
   vkCmdSetLineWidth(cmd, linesDrawnWidth(context, line_width_px));
   // Datasets in scene order, so primitive order (and with it the depth

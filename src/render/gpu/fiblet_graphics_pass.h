@@ -65,7 +65,9 @@ void recordFibletDrawArgs(VkCommandBuffer cmd, const FibletGraphicsPass& pass, c
 // pre-rasterisation stages.
 void recordFibletGraphics(VkCommandBuffer cmd, const gpu::VulkanContext& context, FibletGraphicsPass& pass,
                           const SceneLayout& scene, const GpuFrameTargets& frame, const CullBuffers* culled,
-                          float line_width_px);
+                          float line_width_px, bool resume = false);
+// `resume`: over what the last call left (resumeLineAttachments) instead
+// of cleared: two-phase culling's second phase.
 
 // The shader stages the pipeline of `kind` reads buffers in (for barriers).
 VkPipelineStageFlags2 fibletGraphicsShaderStages(RenderPipeline kind);

@@ -30,8 +30,8 @@ class FibletGraphicsStage final : public FrameStage {
     destroyCullPasses(context, cull_passes_);
     destroyFibletGraphicsPass(context, pass_);
   }
-  // cull, draw.
-  uint32_t maxPasses() const override { return 2; }
+  // cull 1, draw 1, depth pyramid, cull 2, draw 2.
+  uint32_t maxPasses() const override { return 5; }
   bool runs(const FrameContext& frame) const override { return frame.settings.pipeline == kind_; }
   void resize(const gpu::VulkanContext& context, uint32_t, uint32_t) override {
     releaseLineAttachments(context, pass_.attachments);
@@ -41,12 +41,8 @@ class FibletGraphicsStage final : public FrameStage {
   }
 
   void check(const FrameContext& frame) const override {
-    const std::string name(renderPipelineName(kind_));
-    if (frame.scene.datasets.empty()) throw Error("render: the " + name + " pipeline needs fiblets");
-    if (frame.settings.culling == CullingMode::TwoPhase)
-      throw Error("render: the " + name +
-                  " pipeline culls with none or frustum (two-phase culling builds its depth pyramid from the "
-                  "compute rasters; use --culling frustum)");
+    if (frame.scene.datasets.empty())
+      throw Error("render: the " + std::string(renderPipelineName(kind_)) + " pipeline needs fiblets");
   }
 
   void record(FrameContext& frame) override {
@@ -56,39 +52,29 @@ class FibletGraphicsStage final : public FrameStage {
     ensureLineAttachments(frame.context, pass_.attachments, frame.targets.width, frame.targets.height);
     frame.stats.fiblets_total = layout.fiblets;
     culled_ = (settings.culling != CullingMode::None || frame.scene.kept_bits != 0) && layout.fiblets > 0;
-    const VkPipelineStageFlags2 shaders = fibletGraphicsShaderStages(kind_);
-    if (culled_) {
-      std::vector<uint32_t> fiblets;
-      for (const SceneEntry& e : layout.entries) fiblets.push_back(e.dataset->block().fiblet_count);
-      prepareCullBuffers(frame.context, cull_buffers_, fiblets, frame.targets.width, frame.targets.height);
-      // The lists' draws are this pass's successors: its barrier is
-      // recordFibletDrawArgs's own.
-      gpu::PassScope pass(frame.cmd, frame.timer, "cull", gpu::kNoBarrier);
-      recordCullLists(frame.cmd, frame.context, cull_passes_, layout, frame.targets, cull_buffers_,
-                      CullFrame{settings.culling, 0.0f, cullFocalPixels(frame.camera), frame.scene.kept_bits});
-      recordFibletDrawArgs(frame.cmd, pass_, cull_buffers_);
-    } else {
+    if (!culled_) {
       frame.stats.fiblets_drawn = layout.fiblets;
+      draw(frame, nullptr, false, std::string(renderPipelineName(kind_)));
+      return;
     }
+    std::vector<uint32_t> fiblets;
+    for (const SceneEntry& e : layout.entries) fiblets.push_back(e.dataset->block().fiblet_count);
+    prepareCullBuffers(frame.context, cull_buffers_, fiblets, frame.targets.width, frame.targets.height);
+    const CullFrame cull{settings.culling, 0.0f, cullFocalPixels(frame.camera), frame.scene.kept_bits};
+    const bool two_phase = settings.culling == CullingMode::TwoPhase;
+    const std::string name(renderPipelineName(kind_));
+    // Phase 1 (the only one without TwoPhase): last frame's visible
+    // fiblets, as the compute stage's recordCulledRaster.
+    cullAndDraw(frame, cull, two_phase ? 1 : 0, two_phase ? name + " 1" : name);
+    if (!two_phase) return;
     {
-      // The copy into the G-buffer before the compute passes that read it.
-      const gpu::PassBarrier after{VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                                   VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, gpu::kStorageReadWrite};
-      gpu::PassScope pass(frame.cmd, frame.timer, std::string(renderPipelineName(kind_)), after);
-      recordFibletGraphics(frame.cmd, frame.context, pass_, layout, frame.targets, culled_ ? &cull_buffers_ : nullptr,
-                           settings.line_width_px);
+      // The max-depth pyramid of what phase 1 drew, from the G-buffer copy
+      // (the copy's writes before it: the draw pass's barrier).
+      gpu::PassScope pass(frame.cmd, frame.timer, "depth pyramid", gpu::kComputeToCompute);
+      recordDepthPyramid(frame.cmd, cull_passes_, frame.targets, cull_buffers_, true);
     }
-    if (culled_) {
-      // The draws' reads of the lists and arguments before the count copies
-      // (and the next frame's resets).
-      // The cull's count writes, made visible to the copies.
-      gpu::memoryBarrier(frame.cmd,
-                         VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT | shaders,
-                         VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                         VK_PIPELINE_STAGE_2_TRANSFER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                         VK_ACCESS_2_TRANSFER_READ_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT);
-      recordCullListStats(frame.cmd, cull_buffers_);
-    }
+    // Phase 2: the rest against the pyramid, drawn over phase 1.
+    cullAndDraw(frame, cull, 2, name + " 2");
   }
 
   void collect(const gpu::VulkanContext& context, FrameStats& stats) override {
@@ -104,6 +90,38 @@ class FibletGraphicsStage final : public FrameStage {
   void ensurePipelines(const gpu::VulkanContext& context) {
     if (pass_.pipeline.pipeline == VK_NULL_HANDLE) pass_ = createFibletGraphicsPass(context, kind_);
     if (cull_passes_.cull.pipeline == VK_NULL_HANDLE) cull_passes_ = createCullPasses(context);
+  }
+
+  // The draw pass (its G-buffer copy before the compute passes that read it).
+  void draw(FrameContext& frame, const CullBuffers* culled, bool resume, const std::string& name) {
+    const gpu::PassBarrier after{VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                 VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, gpu::kStorageReadWrite};
+    gpu::PassScope pass(frame.cmd, frame.timer, name, after);
+    recordFibletGraphics(frame.cmd, frame.context, pass_, frame.layout, frame.targets, culled,
+                         frame.settings.line_width_px, resume);
+  }
+
+  // One cull phase (0: Frustum or None; 1, 2: TwoPhase), its draw, and its
+  // counts for collect().
+  void cullAndDraw(FrameContext& frame, const CullFrame& cull, uint32_t phase, const std::string& draw_name) {
+    {
+      // The lists' draws are this pass's successors: its barrier is
+      // recordFibletDrawArgs's own.
+      gpu::PassScope pass(frame.cmd, frame.timer, phase == 0 ? "cull" : "cull " + std::to_string(phase),
+                          gpu::kNoBarrier);
+      recordCullLists(frame.cmd, frame.context, cull_passes_, frame.layout, frame.targets, cull_buffers_, cull, phase);
+      recordFibletDrawArgs(frame.cmd, pass_, cull_buffers_);
+    }
+    draw(frame, &cull_buffers_, phase == 2, draw_name);
+    // The draws' reads of the lists and arguments before the count copies
+    // (and the next resets); the cull's count writes made visible to them.
+    gpu::memoryBarrier(frame.cmd,
+                       VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT |
+                           fibletGraphicsShaderStages(kind_),
+                       VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                       VK_PIPELINE_STAGE_2_TRANSFER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                       VK_ACCESS_2_TRANSFER_READ_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    recordCullListStats(frame.cmd, cull_buffers_, phase);
   }
 
   RenderPipeline kind_;

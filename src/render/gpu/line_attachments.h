@@ -35,6 +35,9 @@ void releaseLineAttachments(const gpu::VulkanContext& context, LineAttachments& 
 // texel (depth 1.0, no fiber, segment and tangent 0) and depth 1, after the
 // previous frame's copy out of the colour attachment.
 void beginLineAttachments(VkCommandBuffer cmd, LineAttachments& a);
+// Begins rendering that keeps what endLineAttachmentsIntoGBuffer left (the
+// second phase of two-phase culling draws over the first).
+void resumeLineAttachments(VkCommandBuffer cmd, LineAttachments& a);
 // Ends rendering and copies the colour attachment into frame.gbuffer
 // (written at the TRANSFER stage when this returns).
 void endLineAttachmentsIntoGBuffer(VkCommandBuffer cmd, LineAttachments& a, const GpuFrameTargets& frame);
