@@ -14,7 +14,10 @@
 // joining points of different fiblets, and a frame is 50x slower than the
 // geometry pipeline's; the decode in the control stage (a 32-lane scan, or
 // two 31-point halves) and a patch output for the fiblet gave the same
-// wrong image, so the cause is not the decode's placement. Not resolved:
+// wrong image, so the cause is not the decode's placement; nor are the clip
+// distances (the same image without them) or the levels varying from patch
+// to patch (the same with every patch at level 60). Not resolved (a GPU
+// driver would tell whether lavapipe is at fault):
 // tests/unit/gpu_fiblet_graphics_test.cpp keeps this pipeline's image
 // tests DISABLED_.
 //
