@@ -5,14 +5,14 @@
 // one, at most 60 < 64, the minimum maxTessellationGenerationLevel); the
 // evaluation stage (fiblet_lines.tese) decodes.
 //
-// Why the decode is not here: this stage's outputs are what the evaluation
-// stage could read the points from, and two versions that decoded here
-// drew wrong points on lavapipe and took 50-250x the geometry pipeline's
-// time there: a 32-invocation patch with the paper's log-step prefix
-// (3.3.2) across the control-point outputs, barrier() between steps, and a
-// 2-invocation patch of 31 points (124 output components) each. Both are
-// what a CPU driver emulates worst, and neither was right there in the time
-// I had, so the evaluation stage decodes instead (see its header).
+// Why the decode is not here: the evaluation stage's invocations are
+// independent, so each decodes its own vertex (see its header) and nothing
+// passes between the stages but the fiblet (patch_fiblet). Two versions
+// that decoded here (a 32-invocation patch with the paper's log-step prefix
+// across the control-point outputs, barrier() between steps; two
+// invocations of 31 points each) were tried while lavapipe's large-draw
+// problem (fiblet_graphics_pass.h) still hid every result, and were dropped
+// before it was found.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_buffer_reference : require
@@ -26,11 +26,13 @@ layout(vertices = 1) out;
 layout(push_constant, std430) uniform Push { FibletDrawPush pc; };
 
 layout(location = 0) in uint in_fiblet[];
+layout(location = 0) patch out uint patch_fiblet;
 
 
 void main() {
   const FibletDataset ds = DatasetRef(pc.dataset).ds;
   const uint f = in_fiblet[0];
+  patch_fiblet = f;
   uint drawn = 0u;
   if (f < ds.fiblet_count) {
     const uint flags = fibletRecordByte(WordsRef(ds.records), f * ds.record_words, fibletFlagsByte(ds.points_per_fiblet));

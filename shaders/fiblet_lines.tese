@@ -10,16 +10,10 @@
 // price of a decode that is right on every driver (fiblet_lines.tesc says
 // why the control stage does not decode).
 //
-// KNOWN PROBLEM: on lavapipe (Mesa) the isolines come out with segments
-// joining points of different fiblets, and a frame is 50x slower than the
-// geometry pipeline's; the decode in the control stage (a 32-lane scan, or
-// two 31-point halves) and a patch output for the fiblet gave the same
-// wrong image, so the cause is not the decode's placement; nor are the clip
-// distances (the same image without them) or the levels varying from patch
-// to patch (the same with every patch at level 60). Not resolved (a GPU
-// driver would tell whether lavapipe is at fault):
-// tests/unit/gpu_fiblet_graphics_test.cpp keeps this pipeline's image
-// tests DISABLED_.
+// The fiblet comes from the control stage as a patch output (the vertex
+// shader read it at gl_VertexIndex), not from gl_PrimitiveID: the draws may
+// be split (fiblet_graphics_pass.h: lavapipe mixes up patches in large
+// draws), and gl_PrimitiveID restarts at every draw.
 //
 // Flat outputs as fiblet_lines.geom's: vertex i carries segment i's values
 // (its index within the fiblet, as the compute payload; the packed tangent
@@ -42,6 +36,8 @@ layout(isolines, equal_spacing) in;
 
 layout(push_constant, std430) uniform Push { FibletDrawPush pc; };
 
+layout(location = 0) patch in uint patch_fiblet;
+
 
 out gl_PerVertex {
   vec4 gl_Position;
@@ -54,11 +50,7 @@ layout(location = 2) flat out uint out_tangent;
 
 void main() {
   const FibletDataset ds = DatasetRef(pc.dataset).ds;
-  // The patch is the draw's vertex gl_PrimitiveID: the fiblet as the vertex
-  // shader found it, found again here rather than passed as a patch output
-  // (a patch output gave the same wrong image on lavapipe: see the tests).
-  const uint slot = uint(gl_PrimitiveID);
-  const uint fiblet = pc.list != 0ul ? FibletListRef(pc.list).fiblets[slot] : slot;
+  const uint fiblet = patch_fiblet;
   WordsRef records = WordsRef(ds.records);
   const uint base = fiblet * ds.record_words;
   const uint flags = fibletRecordByte(records, base, fibletFlagsByte(ds.points_per_fiblet));
@@ -82,8 +74,15 @@ void main() {
     if (i >= 1u && i == need) a = s.t;  // i = used: point i is the last decoded one
     b = s.t;
   }
-  // (Only when the segment is drawn: the last fiblet has no next record.)
-  if (i + 1u > used && i < segments) b = fibletFirstPoint(records, base + ds.record_words);
+  // Past the decoded points lies the next fiblet's first point: b of the
+  // joining segment (i = used), and a of the isoline's last vertex when the
+  // fiblet has that segment (i = used + 1). Only then: the last fiblet has
+  // no next record.
+  if (segments > used && i + 1u > used) {
+    const vec3 next = fibletFirstPoint(records, base + ds.record_words);
+    if (i == used) b = next;
+    else a = next;
+  }
   const vec3 p = fibletToWorld(ds, a);
   const CameraBlock cam = CameraRef(pc.camera).camera;
   gl_Position = cameraTransformPoint(cam.view_projection, p);

@@ -56,16 +56,21 @@ struct FibletDrawPush {
 
 // fiblet_draw_args.comp: a cull list's count -> a VkDrawIndirectCommand
 // (count vertices: one point or one one-vertex patch per fiblet).
+// fiblet_draw_args.comp: `commands` VkDrawIndirectCommand from one cull
+// list, command k drawing list slots [k * chunk, (k + 1) * chunk) (fewer or
+// none past the list's count).
 struct FibletDrawArgsPush {
   uint64_t list;  // FibletList
-  uint64_t args;  // VkDrawIndirectCommand (4 uints)
+  uint64_t args;  // the region's first VkDrawIndirectCommand (4 uints each)
+  uint chunk;     // list slots per command (0xFFFFFFFF: one command for all)
+  uint commands;
 };
 
 SHADER_NAMESPACE_END
 
 #ifdef __cplusplus
 static_assert(sizeof(fibscope::shader::FibletDrawPush) == 32, "");
-static_assert(sizeof(fibscope::shader::FibletDrawArgsPush) == 16, "");
+static_assert(sizeof(fibscope::shader::FibletDrawArgsPush) == 24, "");
 static_assert(sizeof(fibscope::shader::FibletRasterPush) == 48, "");
 static_assert(sizeof(fibscope::shader::FibletResolvePush) == 40, "");
 #endif

@@ -1,5 +1,6 @@
 #include "render/gpu/fiblet_graphics_pass.h"
 
+#include <algorithm>
 #include <string>
 
 #include "core/error.h"
@@ -78,12 +79,12 @@ FibletGraphicsPass createFibletGraphicsPass(const gpu::VulkanContext& context, R
   desc.dynamic_line_width = true;
   FibletGraphicsPass pass;
   pass.kind = kind;
+  if (kind == RenderPipeline::Tessellation && context.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU)
+    pass.patches_per_draw = kCpuTessellationPatchesPerDraw;
   try {
     pass.pipeline = gpu::createGraphicsPipeline(context, desc);
     pass.draw_args =
         gpu::createComputePipeline(context, "fiblet_draw_args.comp", sizeof(shader::FibletDrawArgsPush));
-    pass.args = gpu::createBuffer(context, shader::kMaxSceneDatasets * sizeof(VkDrawIndirectCommand),
-                                  gpu::MemoryUse::DeviceLocal, VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
   } catch (...) {
     destroyFibletGraphicsPass(context, pass);
     throw;
@@ -98,14 +99,38 @@ void destroyFibletGraphicsPass(const gpu::VulkanContext& context, FibletGraphics
   gpu::destroyGraphicsPipeline(context, pass.pipeline);
 }
 
+void ensureFibletDrawArgs(const gpu::VulkanContext& context, FibletGraphicsPass& pass, const SceneLayout& scene) {
+  pass.command_first.clear();
+  pass.command_count.clear();
+  uint64_t total = 0;
+  for (const SceneEntry& e : scene.entries) {
+    const uint32_t n = pass.patches_per_draw == 0
+                           ? 1u
+                           : std::max<uint32_t>(1, (e.fiblets + pass.patches_per_draw - 1) / pass.patches_per_draw);
+    pass.command_first.push_back(uint32_t(total));
+    pass.command_count.push_back(n);
+    total += n;
+  }
+  const VkDeviceSize bytes = std::max<uint64_t>(total, 1) * sizeof(VkDrawIndirectCommand);
+  if (pass.args.size >= bytes) return;
+  vkDeviceWaitIdle(context.device());  // earlier frames may read them
+  gpu::destroyBuffer(context, pass.args);
+  pass.args = gpu::createBuffer(context, bytes, gpu::MemoryUse::DeviceLocal, VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
+}
+
 void recordFibletDrawArgs(VkCommandBuffer cmd, const FibletGraphicsPass& pass, const CullBuffers& buffers) {
+  if (pass.command_first.size() != buffers.regions.size())
+    throw Error("render: the draw commands were prepared for " + std::to_string(pass.command_first.size()) +
+                " datasets, the cull lists for " + std::to_string(buffers.regions.size()));
   // The previous frame's draws read the arguments (write-after-read).
   gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT, 0, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, 0);
   shader::FibletDrawArgsPush push{};
+  push.chunk = pass.patches_per_draw == 0 ? 0xFFFFFFFFu : pass.patches_per_draw;
   for (size_t i = 0; i < buffers.regions.size(); ++i) {
     push.list = buffers.list.address + buffers.regions[i].list_offset;
-    push.args = pass.args.address + i * sizeof(VkDrawIndirectCommand);
-    gpu::recordDispatch(cmd, pass.draw_args, push, 1);
+    push.args = pass.args.address + uint64_t(pass.command_first[i]) * sizeof(VkDrawIndirectCommand);
+    push.commands = pass.command_count[i];
+    gpu::recordDispatch(cmd, pass.draw_args, push, (push.commands + 63) / 64);
   }
   gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                      VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT,
@@ -135,10 +160,21 @@ void recordFibletGraphics(VkCommandBuffer cmd, const gpu::VulkanContext& context
     push.list = culled ? culled->list.address + culled->regions[i].list_offset : 0;
     push.fiber_base = e.fiber_base;
     vkCmdPushConstants(cmd, pass.pipeline.layout, pass.pipeline.stages, 0, sizeof(push), &push);
-    if (culled)
-      vkCmdDrawIndirect(cmd, pass.args.buffer, i * sizeof(VkDrawIndirectCommand), 1, sizeof(VkDrawIndirectCommand));
-    else
-      vkCmdDraw(cmd, e.fiblets, 1, 0, 0);
+    const uint32_t chunk = pass.patches_per_draw == 0 ? e.fiblets : pass.patches_per_draw;
+    if (culled) {
+      const VkDeviceSize offset = VkDeviceSize(pass.command_first[i]) * sizeof(VkDrawIndirectCommand);
+      const uint32_t commands = pass.command_count[i];
+      if (commands == 1 || (context.enabledFeatures().multiDrawIndirect && commands <= context.limits().maxDrawIndirectCount)) {
+        vkCmdDrawIndirect(cmd, pass.args.buffer, offset, commands, sizeof(VkDrawIndirectCommand));
+      } else {
+        for (uint32_t k = 0; k < commands; ++k)
+          vkCmdDrawIndirect(cmd, pass.args.buffer, offset + k * sizeof(VkDrawIndirectCommand), 1,
+                            sizeof(VkDrawIndirectCommand));
+      }
+    } else {
+      for (uint32_t first = 0; first < e.fiblets; first += chunk)
+        vkCmdDraw(cmd, std::min(chunk, e.fiblets - first), 1, first, 0);
+    }
   }
   endLineAttachmentsIntoGBuffer(cmd, pass.attachments, frame);
 }

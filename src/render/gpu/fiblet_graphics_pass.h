@@ -16,6 +16,13 @@
 // One draw per dataset: vkCmdDraw of every fiblet, or, culled, one
 // vkCmdDrawIndirect per dataset whose arguments fiblet_draw_args.comp
 // writes from the cull list's count (the vertex shader reads the list).
+// Except tessellation on CPU devices: lavapipe (Mesa 22.3) hands the
+// control and evaluation stages another patch's inputs in draws of many
+// patches (measured: a 400-fiber phantom drew half its pixels, or segments
+// joining unrelated fiblets; drawn in draws of 64 patches, it matches the
+// lines baseline, and 25 times faster), so there each draw covers at most
+// kCpuTessellationPatchesPerDraw fiblets: several vkCmdDraw, or one
+// multi-draw vkCmdDrawIndirect of several commands.
 // Line rasterisation differs from the compute rasters' capsule rule by up
 // to about a pixel (see lines_pass.h); the tests measure by how much.
 #pragma once
@@ -23,6 +30,7 @@
 #include <vulkan/vulkan.h>
 
 #include <cstdint>
+#include <vector>
 
 #include "gpu/buffer.h"
 #include "gpu/compute_pipeline.h"
@@ -40,9 +48,15 @@ struct FibletGraphicsPass {
   RenderPipeline kind = RenderPipeline::Geometry;  // Geometry or Tessellation
   gpu::GraphicsPipeline pipeline;
   gpu::ComputePipeline draw_args;  // fiblet_draw_args.comp
-  gpu::Buffer args;                // VkDrawIndirectCommand per dataset (kMaxSceneDatasets)
+  gpu::Buffer args;                // the draw commands (ensureFibletDrawArgs)
   LineAttachments attachments;     // none until the first frame
+  uint32_t patches_per_draw = 0;   // 0: no cap (see above)
+  // Per scene entry, its first command in `args` and how many (one without
+  // a cap, else one per patches_per_draw fiblets of the dataset).
+  std::vector<uint32_t> command_first, command_count;
 };
+
+inline constexpr uint32_t kCpuTessellationPatchesPerDraw = 64;
 
 // The pipeline of `kind` (Geometry or Tessellation). Throws Error (one
 // line) when the device lacks a graphics queue, the stage's feature
@@ -52,7 +66,11 @@ struct FibletGraphicsPass {
 FibletGraphicsPass createFibletGraphicsPass(const gpu::VulkanContext& context, RenderPipeline kind);
 void destroyFibletGraphicsPass(const gpu::VulkanContext& context, FibletGraphicsPass& pass);
 
-// Culled frames: each region's draw arguments from its full-detail list
+// The draw commands of `scene`'s datasets: `args` grown when too small
+// (after waiting for the device), command_first / command_count set.
+void ensureFibletDrawArgs(const gpu::VulkanContext& context, FibletGraphicsPass& pass, const SceneLayout& scene);
+
+// Culled frames (after ensureFibletDrawArgs for the scene): each region's draw arguments from its full-detail list
 // (recordCullLists before, its writes visible to compute); the arguments
 // and lists are visible to the draws when this returns.
 void recordFibletDrawArgs(VkCommandBuffer cmd, const FibletGraphicsPass& pass, const CullBuffers& buffers);

@@ -60,6 +60,7 @@ class FibletGraphicsStage final : public FrameStage {
     std::vector<uint32_t> fiblets;
     for (const SceneEntry& e : layout.entries) fiblets.push_back(e.dataset->block().fiblet_count);
     prepareCullBuffers(frame.context, cull_buffers_, fiblets, frame.targets.width, frame.targets.height);
+    ensureFibletDrawArgs(frame.context, pass_, layout);
     const CullFrame cull{settings.culling, 0.0f, cullFocalPixels(frame.camera), frame.scene.kept_bits};
     const bool two_phase = settings.culling == CullingMode::TwoPhase;
     const std::string name(renderPipelineName(kind_));
