@@ -25,7 +25,9 @@ void main() {
   if (p.x >= w || p.y >= h) return;
   PyramidRef pyramid = PyramidRef(pc.pyramid);
   float depth;
-  if (pc.level == 0u) {
+  if (pc.level == 0u && pc.gbuffer != 0ul) {
+    depth = GBufferRef(pc.gbuffer).texels[p.y * w + p.x].depth;  // 1 where nothing is drawn
+  } else if (pc.level == 0u) {
     const uint64_t key = VisibilityRef(pc.visibility).keys[visibilityIndex(p.x, p.y, w)];
     depth = key == 0xFFFFFFFFFFFFFFFFul ? 1.0 : visibilityDepth(key);
   } else {

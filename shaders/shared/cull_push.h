@@ -116,7 +116,10 @@ struct FibletListFinalizePush {
 
 // depth_pyramid.comp: one dispatch per level.
 struct DepthPyramidPush {
-  uint64_t visibility;  // level 0 reads the visibility keys
+  uint64_t visibility;  // level 0 reads the visibility keys ...
+  // ... or, when not 0, the G-buffer's depths (GBufferTexel per pixel): the
+  // graphics fiblet pipelines, which write no visibility keys
+  uint64_t gbuffer;
   uint64_t pyramid;
   uint width;  // level 0 = the frame size
   uint height;
@@ -173,7 +176,7 @@ SHADER_NAMESPACE_END
 static_assert(sizeof(fibscope::shader::FibletCullPush) == 72, "");
 static_assert(sizeof(fibscope::shader::FibletBoundsPush) == 16, "");
 static_assert(sizeof(fibscope::shader::FibletListFinalizePush) == 16, "");
-static_assert(sizeof(fibscope::shader::DepthPyramidPush) == 32, "");
+static_assert(sizeof(fibscope::shader::DepthPyramidPush) == 40, "");
 static_assert(sizeof(fibscope::shader::FibletLodRasterPush) == 48, "");
 #endif
 

@@ -40,9 +40,37 @@ struct FibletResolvePush {
   uint height;
 };
 
+// fiblet_lines.vert (+ fiblet_lines.geom, or fiblet_lines.tesc/.tese) and
+// fiblet_lines.frag: the graphics fiblet pipelines, one draw per dataset.
+struct FibletDrawPush {
+  uint64_t dataset;  // FibletDataset block
+  uint64_t camera;   // CameraBlock
+  // 0: the fiblet is gl_VertexIndex (every fiblet of the dataset).
+  // Otherwise a FibletList (the cull's): fiblet list.fiblets[gl_VertexIndex].
+  uint64_t list;
+  // The dataset's first fiber in the scene's numbering (shared/scene_table.h):
+  // the G-buffer's fiber is fiber_base + fiblet_fiber[fiblet], as the resolve's.
+  uint fiber_base;
+  uint pad;
+};
+
+// fiblet_draw_args.comp: a cull list's count -> a VkDrawIndirectCommand
+// (count vertices: one point or one one-vertex patch per fiblet).
+// fiblet_draw_args.comp: `commands` VkDrawIndirectCommand from one cull
+// list, command k drawing list slots [k * chunk, (k + 1) * chunk) (fewer or
+// none past the list's count).
+struct FibletDrawArgsPush {
+  uint64_t list;  // FibletList
+  uint64_t args;  // the region's first VkDrawIndirectCommand (4 uints each)
+  uint chunk;     // list slots per command (0xFFFFFFFF: one command for all)
+  uint commands;
+};
+
 SHADER_NAMESPACE_END
 
 #ifdef __cplusplus
+static_assert(sizeof(fibscope::shader::FibletDrawPush) == 32, "");
+static_assert(sizeof(fibscope::shader::FibletDrawArgsPush) == 24, "");
 static_assert(sizeof(fibscope::shader::FibletRasterPush) == 48, "");
 static_assert(sizeof(fibscope::shader::FibletResolvePush) == 40, "");
 #endif

@@ -100,7 +100,7 @@ std::vector<Variant> variantsFrom(const BenchOptions& o) {
     v.settings.pipeline = parseRenderPipeline(spec.substr(0, slash));
     if (slash != std::string::npos) v.settings.culling = parseCullingMode(spec.substr(slash + 1));
     v.label = std::string(renderPipelineName(v.settings.pipeline));
-    if (v.settings.pipeline == RenderPipeline::Compute) v.label += "/" + std::string(cullingModeName(v.settings.culling));
+    if (drawsFiblets(v.settings.pipeline)) v.label += "/" + std::string(cullingModeName(v.settings.culling));
     variants.push_back(std::move(v));
   }
   return variants;
@@ -130,7 +130,7 @@ void runBench(const BenchOptions& o) {
   parseFrameSize(o.render.size, width, height);
   const std::optional<NiftiVolume> volume = readAnatomyOption(o.render);  // a bad file before any work
   bool need_points = false;
-  for (const Variant& v : variants) need_points |= v.settings.pipeline != RenderPipeline::Compute;
+  for (const Variant& v : variants) need_points |= !drawsFiblets(v.settings.pipeline);
 
   auto context = createRenderContext(o.render);
   SceneOptions scene_options;
@@ -196,7 +196,7 @@ void runBench(const BenchOptions& o) {
       // drawn fraction of the dataset's segments (fiblets hold ~N - 1 each)
       // plus one per LoD fiblet.
       v.segments_drawn_sum +=
-          v.settings.pipeline == RenderPipeline::Compute
+          drawsFiblets(v.settings.pipeline)
               ? uint64_t(double(scene.segments) * double(stats.fiblets_drawn) / total_fiblets) + stats.fiblets_lod
               : scene.segments;
       for (const PassTiming& p : stats.passes) {
@@ -254,7 +254,7 @@ void runBench(const BenchOptions& o) {
     j["median_ms"] = median;
     j["p95_ms"] = percentile(v.gpu_ms, 95);
     j["wall_mean_ms"] = mean(v.wall_ms);
-    const bool fiblets = v.settings.pipeline == RenderPipeline::Compute;  // the baselines draw every segment
+    const bool fiblets = drawsFiblets(v.settings.pipeline);  // the baselines draw every segment
     if (fiblets) {
       j["fiblets_drawn_fraction"] = mean(v.drawn_fraction);
       j["fiblets_lod_fraction"] = mean(v.lod_fraction);
@@ -288,8 +288,8 @@ void addBenchCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("bench", "Frame benchmark: the camera orbits the tractogram (fiblets paper protocol)");
   addRenderCliOptions(cmd, o->render);
   cmd->add_option("--compare", o->compare,
-                  "Pipelines drawn on the same frames, e.g. compute/two-phase,compute/none,lines,raw-compute; ratios "
-                  "are to the first");
+                  "Pipelines drawn on the same frames, e.g. compute/two-phase,compute/none,lines,raw-compute,geometry/frustum,"
+                  "tessellation/none; ratios are to the first");
   cmd->add_option("--frames", o->frames, "Measured frames")->capture_default_str();
   cmd->add_option("--step", o->step_deg, "Orbit step per frame, degrees")->capture_default_str();
   cmd->add_option("--elevation", o->elevation_deg, "Orbit elevation, degrees")->capture_default_str();

@@ -132,7 +132,7 @@ void runRender(RenderCommandOptions o) {
   SceneOptions scene_options;
   scene_options.path = o.render.input;
   scene_options.phantom_streamlines = o.render.phantom_streamlines;
-  scene_options.upload_raw = settings.pipeline != RenderPipeline::Compute;
+  scene_options.upload_raw = !drawsFiblets(settings.pipeline);
   scene_options.fiber_scalars = criteria.scalar_ranges;
   LoadedScene scene = loadScene(waitForDevice, scene_options);
   const gpu::VulkanContext& context = waitForDevice();

@@ -28,7 +28,7 @@ SceneFilter::SceneFilter(const gpu::VulkanContext& context, const LoadedScene& s
 
 void SceneFilter::apply(GpuScene& scene, RenderPipeline pipeline) const {
   if (!active()) return;
-  const GpuFiberFilter& f = pipeline == RenderPipeline::Compute || !raw_ ? *fiblets_ : *raw_;
+  const GpuFiberFilter& f = drawsFiblets(pipeline) || !raw_ ? *fiblets_ : *raw_;
   if (f.zoneDistances() != 0) scene.fiber_scalars = f.zoneDistances();
   if (dim_) {
     // Kept fibers as the selection: the rest dimmed. (Nothing kept: an

@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <vector>
 
 #include "gpu/shader_library.h"
 #include "gpu/vk_check.h"
@@ -21,8 +22,6 @@ VkShaderModule createModule(const VulkanContext& context, std::string_view name)
   return module;
 }
 
-constexpr VkShaderStageFlags kStages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
-
 }  // namespace
 
 GraphicsPipeline createGraphicsPipeline(const VulkanContext& context, const GraphicsPipelineDesc& desc) {
@@ -34,30 +33,49 @@ GraphicsPipeline createGraphicsPipeline(const VulkanContext& context, const Grap
                 " bytes of push constants (" + context.info().name + " allows " +
                 std::to_string(context.limits().maxPushConstantsSize) + ", multiple of 4)");
 
-  VkShaderModule vertex = createModule(context, desc.vertex_shader);
-  VkShaderModule fragment = VK_NULL_HANDLE;
+  // The stages in pipeline order (vertex, tessellation, geometry, fragment).
+  struct Stage {
+    VkShaderStageFlagBits stage;
+    std::string_view shader;
+  };
+  std::vector<Stage> wanted = {{VK_SHADER_STAGE_VERTEX_BIT, desc.vertex_shader}};
+  if (!desc.tess_control_shader.empty()) {
+    wanted.push_back({VK_SHADER_STAGE_TESSELLATION_CONTROL_BIT, desc.tess_control_shader});
+    wanted.push_back({VK_SHADER_STAGE_TESSELLATION_EVALUATION_BIT, desc.tess_evaluation_shader});
+  }
+  if (!desc.geometry_shader.empty()) wanted.push_back({VK_SHADER_STAGE_GEOMETRY_BIT, desc.geometry_shader});
+  wanted.push_back({VK_SHADER_STAGE_FRAGMENT_BIT, desc.fragment_shader});
+  result.name.clear();
+  for (const Stage& w : wanted) result.name += (result.name.empty() ? "" : " + ") + std::string(w.shader);
+  for (const Stage& w : wanted) result.stages |= w.stage;
+
+  std::vector<VkShaderModule> modules;
+  auto destroyModules = [&] {
+    for (VkShaderModule m : modules) vkDestroyShaderModule(context.device(), m, nullptr);
+  };
   try {
-    fragment = createModule(context, desc.fragment_shader);
+    for (const Stage& w : wanted) modules.push_back(createModule(context, w.shader));
   } catch (...) {
-    vkDestroyShaderModule(context.device(), vertex, nullptr);
+    destroyModules();
     throw;
   }
 
-  VkPushConstantRange range{kStages, 0, desc.push_constant_bytes};
+  VkPushConstantRange range{result.stages, 0, desc.push_constant_bytes};
   VkPipelineLayoutCreateInfo layout_info{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
   layout_info.pushConstantRangeCount = desc.push_constant_bytes > 0 ? 1 : 0;
   layout_info.pPushConstantRanges = &range;
   VkResult r = vkCreatePipelineLayout(context.device(), &layout_info, nullptr, &result.layout);
 
   if (r == VK_SUCCESS) {
-    VkPipelineShaderStageCreateInfo stages[2] = {{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO},
-                                                 {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO}};
-    stages[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
-    stages[0].module = vertex;
-    stages[0].pName = "main";
-    stages[1].stage = VK_SHADER_STAGE_FRAGMENT_BIT;
-    stages[1].module = fragment;
-    stages[1].pName = "main";
+    std::vector<VkPipelineShaderStageCreateInfo> stages(wanted.size());
+    for (size_t i = 0; i < wanted.size(); ++i) {
+      stages[i] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+      stages[i].stage = wanted[i].stage;
+      stages[i].module = modules[i];
+      stages[i].pName = "main";
+    }
+    VkPipelineTessellationStateCreateInfo tessellation{VK_STRUCTURE_TYPE_PIPELINE_TESSELLATION_STATE_CREATE_INFO};
+    tessellation.patchControlPoints = desc.patch_control_points;
 
     VkPipelineVertexInputStateCreateInfo vertex_input{VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
     VkPipelineInputAssemblyStateCreateInfo assembly{VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
@@ -95,8 +113,9 @@ GraphicsPipeline createGraphicsPipeline(const VulkanContext& context, const Grap
 
     VkGraphicsPipelineCreateInfo info{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
     info.pNext = &rendering;
-    info.stageCount = 2;
-    info.pStages = stages;
+    info.stageCount = uint32_t(stages.size());
+    info.pStages = stages.data();
+    info.pTessellationState = desc.tess_control_shader.empty() ? nullptr : &tessellation;
     info.pVertexInputState = &vertex_input;
     info.pInputAssemblyState = &assembly;
     info.pViewportState = &viewport;
@@ -108,8 +127,7 @@ GraphicsPipeline createGraphicsPipeline(const VulkanContext& context, const Grap
     info.layout = result.layout;
     r = vkCreateGraphicsPipelines(context.device(), VK_NULL_HANDLE, 1, &info, nullptr, &result.pipeline);
   }
-  vkDestroyShaderModule(context.device(), vertex, nullptr);
-  vkDestroyShaderModule(context.device(), fragment, nullptr);
+  destroyModules();
   if (r != VK_SUCCESS) {
     destroyGraphicsPipeline(context, result);
     throwIfFailed(r, "creating the graphics pipeline " + result.name);
@@ -172,7 +190,7 @@ void recordDraw(VkCommandBuffer cmd, const GraphicsPipeline& pipeline, const voi
     std::abort();
   }
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline.pipeline);
-  if (push_bytes > 0) vkCmdPushConstants(cmd, pipeline.layout, kStages, 0, push_bytes, push);
+  if (push_bytes > 0) vkCmdPushConstants(cmd, pipeline.layout, pipeline.stages, 0, push_bytes, push);
   vkCmdDraw(cmd, vertex_count, instance_count, 0, 0);
 }
 

@@ -18,11 +18,18 @@ namespace fibscope::gpu {
 struct GraphicsPipelineDesc {
   std::string_view vertex_shader;    // e.g. "lines.vert"
   std::string_view fragment_shader;  // e.g. "lines.frag"
+  // Optional stages (empty: none): a geometry shader (needs the device's
+  // geometryShader feature), a tessellation control + evaluation pair
+  // (tessellationShader; topology PATCH_LIST with patch_control_points).
+  std::string_view geometry_shader;
+  std::string_view tess_control_shader;
+  std::string_view tess_evaluation_shader;
+  uint32_t patch_control_points = 0;
   VkPrimitiveTopology topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
   VkFormat color_format = VK_FORMAT_R8G8B8A8_UNORM;
   VkFormat depth_format = VK_FORMAT_UNDEFINED;  // UNDEFINED: no depth test
   bool primitive_restart = false;               // strips: index 0xffffffff ends one
-  uint32_t push_constant_bytes = 0;             // visible to both stages
+  uint32_t push_constant_bytes = 0;             // visible to every stage of the pipeline
   // The line width is dynamic state (vkCmdSetLineWidth before drawing;
   // widths other than 1 need the wideLines feature).
   bool dynamic_line_width = false;
@@ -32,6 +39,7 @@ struct GraphicsPipeline {
   VkPipeline pipeline = VK_NULL_HANDLE;
   VkPipelineLayout layout = VK_NULL_HANDLE;
   uint32_t push_constant_bytes = 0;
+  VkShaderStageFlags stages = 0;  // the pipeline's stages: the push constants' range
   std::string name;  // "vertex + fragment", for messages
 };
 

@@ -129,6 +129,11 @@ VulkanContext::VulkanContext(const ContextOptions& options) : instance_(options.
   features.features.shaderClipDistance = available.shaderClipDistance;
   features.features.multiDrawIndirect = available.multiDrawIndirect;
   features.features.drawIndirectFirstInstance = available.drawIndirectFirstInstance;
+  // The paper's comparison pipelines (geometry, tessellation) where the
+  // device has the stages; without them those pipelines are refused in one
+  // line.
+  features.features.geometryShader = available.geometryShader;
+  features.features.tessellationShader = available.tessellationShader;
   enabled_ = features.features;
 
   const float priority = 1.0f;

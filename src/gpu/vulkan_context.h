@@ -56,7 +56,9 @@ class VulkanContext {
   const VkPhysicalDeviceLimits& limits() const { return limits_; }
   // The core features enabled on the device: shaderInt64, and wideLines,
   // multiDrawIndirect and drawIndirectFirstInstance where the device has
-  // them (the lines baseline falls back without them).
+  // them (the lines baseline falls back without them); geometryShader and
+  // tessellationShader where the device has them (the geometry and
+  // tessellation fiblet pipelines need them).
   const VkPhysicalDeviceFeatures& enabledFeatures() const { return enabled_; }
   // The window's surface (VK_NULL_HANDLE without a surface factory); the
   // device can present to it from queue().

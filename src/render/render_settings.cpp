@@ -25,7 +25,9 @@ std::string_view nameOf(Enum value, const std::pair<std::string_view, Enum> (&na
 }
 
 constexpr std::pair<std::string_view, RenderPipeline> kPipelines[] = {
-    {"compute", RenderPipeline::Compute}, {"lines", RenderPipeline::Lines}, {"raw-compute", RenderPipeline::RawCompute}};
+    {"compute", RenderPipeline::Compute},   {"lines", RenderPipeline::Lines},
+    {"raw-compute", RenderPipeline::RawCompute}, {"geometry", RenderPipeline::Geometry},
+    {"tessellation", RenderPipeline::Tessellation}};
 constexpr std::pair<std::string_view, CullingMode> kCulling[] = {
     {"none", CullingMode::None}, {"frustum", CullingMode::Frustum}, {"two-phase", CullingMode::TwoPhase}};
 constexpr std::pair<std::string_view, ColorMode> kColors[] = {

@@ -17,9 +17,23 @@ enum class RenderPipeline : uint8_t {
   Compute,     // fiblets: cull -> decode + raster (64-bit atomics) -> resolve
   Lines,       // baseline: raw float vertices as line strips, graphics pipeline, no culling
   RawCompute,  // baseline: the compute raster over raw float vertices, no culling
+  // The paper's comparison pipelines (section 4.5, table 2): the same
+  // fiblets and cull as Compute, decoded in a geometry shader (one point
+  // per fiblet in, a line strip out) or in a tessellation control shader
+  // (one-point patches, isolines); graphics line rasterisation.
+  Geometry,
+  Tessellation,
 };
 
-// Fiblet culling in the compute pipeline (the baselines never cull).
+// The pipeline draws the scene's fiblets (scene numbering, the cull), not
+// the raw vertices of the baselines.
+inline bool drawsFiblets(RenderPipeline pipeline) {
+  return pipeline == RenderPipeline::Compute || pipeline == RenderPipeline::Geometry ||
+         pipeline == RenderPipeline::Tessellation;
+}
+
+// Fiblet culling in the fiblet pipelines (drawsFiblets; the baselines never
+// cull).
 enum class CullingMode : uint8_t {
   None,      // every fiblet is drawn, no LoD
   Frustum,   // dilated frustum (paper eq. 5) and far-view LoD

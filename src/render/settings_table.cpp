@@ -78,8 +78,10 @@ T&& with(T&& info, bool (*relevant)(const RenderSettings&)) {
 // an anatomical volume far fewer; the viewer's sliders span the volume.
 constexpr double kMaxSliceCoordinate = 1e6;
 
-bool isCompute(const RenderSettings& s) { return s.pipeline == RenderPipeline::Compute; }
-bool isCulled(const RenderSettings& s) { return isCompute(s) && s.culling != CullingMode::None; }
+bool isFiblets(const RenderSettings& s) { return drawsFiblets(s.pipeline); }
+// The far-view LoD is the compute pipeline's (the graphics fiblet pipelines
+// draw every culled-in fiblet at full detail).
+bool isCulled(const RenderSettings& s) { return s.pipeline == RenderPipeline::Compute && s.culling != CullingMode::None; }
 bool isSolid(const RenderSettings& s) { return s.color == ColorMode::Solid; }
 bool isScalar(const RenderSettings& s) { return s.color == ColorMode::Scalar; }
 bool isLit(const RenderSettings& s) { return s.lighting == Lighting::IlluminatedLines; }
@@ -89,15 +91,15 @@ bool hasSsao(const RenderSettings& s) { return s.ssao; }
 
 std::vector<SettingInfo> makeTable() {
   std::vector<SettingInfo> t;
-  t.push_back(choice("pipeline", "pipeline", "compute | lines | raw-compute", 3,
+  t.push_back(choice("pipeline", "pipeline", "compute | lines | raw-compute | geometry | tessellation", 5,
                      [](int v) { return renderPipelineName(RenderPipeline(v)); },
                      getChoice<RenderPipeline, &RenderSettings::pipeline>,
                      setChoice<RenderPipeline, &RenderSettings::pipeline>));
-  t.push_back(with(choice("culling", "culling", "none | frustum | two-phase (compute pipeline)", 3,
+  t.push_back(with(choice("culling", "culling", "none | frustum | two-phase (fiblet pipelines: compute, geometry, tessellation)", 3,
                           [](int v) { return cullingModeName(CullingMode(v)); },
                           getChoice<CullingMode, &RenderSettings::culling>,
                           setChoice<CullingMode, &RenderSettings::culling>),
-                   isCompute));
+                   isFiblets));
   t.push_back(with(number("lod-pixels", "LoD below",
                           "Far-view LoD: fiblets whose bounding sphere projects smaller are drawn as one segment "
                           "(frustum and two-phase culling; 0: off)",

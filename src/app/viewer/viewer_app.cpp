@@ -640,7 +640,7 @@ FrameScene ViewerApp::currentScene(bool filter_now) {
 
 void ViewerApp::dissect(FrameScene& scene, bool now) {
   addDissectionCuts(state_.dissection.set, scene.settings);
-  const bool baseline = scene.settings.pipeline != RenderPipeline::Compute && scene.gpu.raw != nullptr;
+  const bool baseline = !drawsFiblets(scene.settings.pipeline) && scene.gpu.raw != nullptr;
   DissectionScene d;
   d.layout = &scene.layout;
   if (!scene.models.empty()) {
@@ -674,7 +674,7 @@ FrameScene ViewerApp::sceneToDraw() {
   state_.baseline_draws_active_only = false;
   const int active = state_.active_model;
   const bool active_shown = active >= 0 && active < int(scenes_.size()) && state_.models[size_t(active)].visible;
-  if (scene.settings.pipeline != RenderPipeline::Compute) {
+  if (!drawsFiblets(scene.settings.pipeline)) {
     // The baselines draw one raw tractogram: the active model's, once its
     // raw vertices are decoded (compute meanwhile, over every visible model).
     if (active_shown && scenes_[size_t(active)]->has_raw) {
@@ -726,7 +726,7 @@ FrameScene ViewerApp::sceneToDraw() {
 // chosen for a model: on a thread (pollRawDecode uploads them), the frames
 // going on with the compute pipeline meanwhile.
 void ViewerApp::ensureRawFor(int model) {
-  if (state_.settings.pipeline == RenderPipeline::Compute || model < 0 || model >= int(scenes_.size())) return;
+  if (drawsFiblets(state_.settings.pipeline) || model < 0 || model >= int(scenes_.size())) return;
   const ViewerModel* m = scenes_[size_t(model)].get();
   if (m->has_raw || (raw_decode_ && raw_decode_->model == m)) return;
   cancelRawDecode();  // another model's: the active one matters

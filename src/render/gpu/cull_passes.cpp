@@ -225,9 +225,10 @@ void destroyCullBuffers(const gpu::VulkanContext& context, CullBuffers& buffers)
 }
 
 void recordDepthPyramid(VkCommandBuffer cmd, const CullPasses& passes, const GpuFrameTargets& frame,
-                        const CullBuffers& buffers) {
+                        const CullBuffers& buffers, bool from_gbuffer) {
   shader::DepthPyramidPush push{};
   push.visibility = frame.visibility.address;
+  push.gbuffer = from_gbuffer ? frame.gbuffer.address : 0;
   push.pyramid = buffers.pyramid.address;
   push.width = frame.width;
   push.height = frame.height;
@@ -284,6 +285,43 @@ void recordCulledRaster(VkCommandBuffer cmd, const gpu::VulkanContext& context, 
                      VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
   buffers.history_valid = two_phase;
   buffers.history_scene = scene;
+}
+
+void recordCullLists(VkCommandBuffer cmd, const gpu::VulkanContext& context, const CullPasses& passes,
+                     const SceneLayout& scene, const GpuFrameTargets& frame, CullBuffers& buffers,
+                     const CullFrame& cull, uint32_t phase) {
+  if (scene.entries.size() != buffers.regions.size())
+    throw Error("cull: the buffers were prepared for " + std::to_string(buffers.regions.size()) +
+                " datasets, the scene has " + std::to_string(scene.entries.size()));
+  const bool two_phase = cull.mode == CullingMode::TwoPhase;
+  if (cull.lod_pixels != 0.0f || two_phase != (phase != 0))
+    throw Error("cull: the list-only cull is without LoD, and in phases 1 and 2 for TwoPhase only");
+  computeToTransfer(cmd);
+  if (phase == 2) {
+    // The phase-1 count copies before the resets below (write-after-read).
+    gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, 0, VK_PIPELINE_STAGE_2_TRANSFER_BIT, 0);
+  } else {
+    vkCmdFillBuffer(cmd, buffers.stats.buffer, 0, VK_WHOLE_SIZE, 0);
+  }
+  if (phase == 1 && (!buffers.history_valid || !sameScene(buffers.history_scene, scene)))
+    vkCmdFillBuffer(cmd, buffers.visible.buffer, 0, VK_WHOLE_SIZE, 0xFFFFFFFFu);
+  resetLists(cmd, buffers);
+  gpu::recordBarrier(cmd, gpu::kTransferToCompute);
+  const uint32_t mode = phase == 1                          ? shader::kCullPhase1
+                        : phase == 2                        ? shader::kCullPhase2
+                        : cull.mode == CullingMode::Frustum ? shader::kCullFrustum
+                                                            : shader::kCullKeptOnly;
+  for (size_t i = 0; i < scene.entries.size(); ++i)
+    recordCull(cmd, context, passes, scene.entries[i], buffers.regions[i], frame, buffers, mode, cull);
+  gpu::computeToComputeBarrier(cmd);
+  buffers.history_valid = phase == 2;
+  if (phase == 2) buffers.history_scene = scene;
+}
+
+void recordCullListStats(VkCommandBuffer cmd, const CullBuffers& buffers, uint32_t phase) {
+  copyCounts(cmd, buffers, phase == 2 ? 1 : 0);
+  gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                     VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
 }
 
 CullStats readCullStats(const gpu::VulkanContext& context, const CullBuffers& buffers) {

@@ -92,8 +92,10 @@ void destroyCullBuffers(const gpu::VulkanContext& context, CullBuffers& buffers)
 // prepareCullBuffers sized for the frame): every level, one dispatch each,
 // with a barrier between levels; the caller makes the visibility writes
 // visible before and places the barrier after.
+// With `from_gbuffer`, level 0 is frame.gbuffer's depths instead (the
+// graphics fiblet pipelines).
 void recordDepthPyramid(VkCommandBuffer cmd, const CullPasses& passes, const GpuFrameTargets& frame,
-                        const CullBuffers& buffers);
+                        const CullBuffers& buffers, bool from_gbuffer = false);
 
 // What recordCulledRaster needs besides the buffers.
 struct CullFrame {
@@ -129,6 +131,24 @@ float cullFocalPixels(const Camera& camera);
 void recordCulledRaster(VkCommandBuffer cmd, const gpu::VulkanContext& context, const CullPasses& passes,
                         const FibletPasses& fiblet_passes, const SceneLayout& scene, const GpuFrameTargets& frame,
                         CullBuffers& buffers, const CullFrame& cull, gpu::GpuTimer* timer);
+
+// The cull alone, for pipelines that draw its lists themselves (the
+// geometry and tessellation fiblet pipelines, which turn each region's
+// full-detail list into an indirect draw): every region's counters reset,
+// then every dataset's cull in `cull.mode` (Frustum or None, the fiber
+// filter only; the lists' writes visible to later compute passes when it
+// returns). LoD goes to the LoD list, which these pipelines do not draw:
+// cull.lod_pixels must be 0. The two-phase history is invalidated.
+// TwoPhase: `phase` 1 (the history reset first where it is not valid, as
+// recordCulledRaster does), then after the caller's draw and
+// recordDepthPyramid, phase 2 (which records the history).
+void recordCullLists(VkCommandBuffer cmd, const gpu::VulkanContext& context, const CullPasses& passes,
+                     const SceneLayout& scene, const GpuFrameTargets& frame, CullBuffers& buffers,
+                     const CullFrame& cull, uint32_t phase = 0);
+// After recordCullLists and the draws that read its lists (their reads
+// before this with a barrier of the caller's): the counts copied for
+// readCullStats (phase 2: into the second phase's slots).
+void recordCullListStats(VkCommandBuffer cmd, const CullBuffers& buffers, uint32_t phase = 0);
 
 // The fiblets drawn by the last recorded frame (summed over its datasets),
 // once it has completed.

@@ -59,7 +59,7 @@ void FrameRenderer::record(VkCommandBuffer cmd, const Camera& camera, const Rend
   validateRenderSettings(settings);
   for (const GpuDataset* dataset : scene.datasets)
     if (!dataset) throw Error("render: a null dataset in the scene");
-  const bool compute = settings.pipeline == RenderPipeline::Compute;
+  const bool compute = drawsFiblets(settings.pipeline);
   if (!compute && !scene.raw)  // the per-fiber attributes are the raw tractogram's fibers'
     throw Error("render: the " + std::string(renderPipelineName(settings.pipeline)) +
                 " pipeline needs the raw tractogram");

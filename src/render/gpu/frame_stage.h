@@ -8,7 +8,8 @@
 //
 // Order of the standard list and what each stage leaves for the next:
 //   setup         camera block written, visibility (and surface target) cleared
-//   geometry      one of compute / raw-compute / lines: the lines' G-buffer
+//   geometry      one of compute / raw-compute / lines / geometry /
+//                 tessellation: the lines' G-buffer
 //   surfaces      any number: nearer-wins writes into the surface target
 //   merge         surface pixels nearer than the lines into the G-buffer
 //   shading       tiles, SSAO, shade, post effects, FXAA: the G-buffer -> RGBA8

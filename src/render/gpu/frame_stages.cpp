@@ -13,6 +13,8 @@ FrameStageList standardFrameStages() {
       makeFibletStage,
       makeRawComputeStage,
       makeLinesStage,
+      makeGeometryStage,
+      makeTessellationStage,
       // Surfaces into the surface target, then merged by depth.
       makeSphereStage,
       makeAnatomyStage,

@@ -23,6 +23,11 @@ std::unique_ptr<FrameStage> makeRawComputeStage(const gpu::VulkanContext& contex
 // "lines": the graphics-pipeline baseline (lines_pass.h; its pipeline
 // made at the first lines frame: compute-only devices never need it).
 std::unique_ptr<FrameStage> makeLinesStage(const gpu::VulkanContext& context);
+// "cull" (frustum or the fiber filter), "geometry" / "tessellation": the
+// paper's comparison pipelines over the scene's fiblets
+// (fiblet_graphics_pass.h; pipelines made at their first frame).
+std::unique_ptr<FrameStage> makeGeometryStage(const gpu::VulkanContext& context);
+std::unique_ptr<FrameStage> makeTessellationStage(const gpu::VulkanContext& context);
 // Surfaces: "spheres", GpuScene::spheres ray-cast (sphere_surface.comp).
 std::unique_ptr<FrameStage> makeSphereStage(const gpu::VulkanContext& context);
 // Surfaces: "slices", GpuScene::anatomy's slices ray-cast (anatomy_slices.comp).
@@ -42,7 +47,7 @@ std::unique_ptr<FrameStage> makeOrientationStage(const gpu::VulkanContext& conte
 
 // tiles, ssao, shade, post, fxaa: the G-buffer (and surface target) -> RGBA8.
 FrameStageList shadingStages();
-// Everything a frame of any pipeline needs, in order: setup, the three
+// Everything a frame of any pipeline needs, in order: setup, the five
 // geometry stages, the surface stages, merge, shading, the orientation
 // overlay.
 FrameStageList standardFrameStages();

@@ -5,18 +5,10 @@
 #include <string>
 
 #include "core/error.h"
-#include "gpu/submit.h"
 #include "shared/raw_tractogram.h"
 #include "shared/render_config.h"
 
 namespace fibscope {
-
-namespace {
-
-constexpr VkFormat kColorFormat = VK_FORMAT_R32G32B32A32_UINT;
-constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
-
-}  // namespace
 
 LinesPass createLinesPass(const gpu::VulkanContext& context) {
   if (!context.info().queue_has_graphics)
@@ -29,8 +21,8 @@ LinesPass createLinesPass(const gpu::VulkanContext& context) {
   desc.vertex_shader = "lines.vert";
   desc.fragment_shader = "lines.frag";
   desc.topology = VK_PRIMITIVE_TOPOLOGY_LINE_STRIP;
-  desc.color_format = kColorFormat;
-  desc.depth_format = kDepthFormat;
+  desc.color_format = kLineColorFormat;
+  desc.depth_format = kLineDepthFormat;
   desc.push_constant_bytes = sizeof(shader::LinesPush);
   desc.dynamic_line_width = true;
   LinesPass pass;
@@ -44,25 +36,11 @@ void destroyLinesPass(const gpu::VulkanContext& context, LinesPass& pass) {
 }
 
 void releaseLinesAttachments(const gpu::VulkanContext& context, LinesPass& pass) {
-  gpu::destroyImage(context, pass.depth);
-  gpu::destroyImage(context, pass.color);
+  releaseLineAttachments(context, pass.attachments);
 }
 
 void ensureLinesAttachments(const gpu::VulkanContext& context, LinesPass& pass, uint32_t width, uint32_t height) {
-  if (pass.color.image != VK_NULL_HANDLE && pass.color.extent.width == width && pass.color.extent.height == height)
-    return;
-  if (pass.color.image != VK_NULL_HANDLE) {
-    vkDeviceWaitIdle(context.device());
-    releaseLinesAttachments(context, pass);
-  }
-  try {
-    pass.color = gpu::createImage2D(context, width, height, kColorFormat,
-                                    VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
-    pass.depth = gpu::createImage2D(context, width, height, kDepthFormat, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT);
-  } catch (...) {
-    releaseLinesAttachments(context, pass);
-    throw;
-  }
+  ensureLineAttachments(context, pass.attachments, width, height);
 }
 
 float linesDrawnWidth(const gpu::VulkanContext& context, float requested_px) {
@@ -77,14 +55,7 @@ float linesDrawnWidth(const gpu::VulkanContext& context, float requested_px) {
 void recordLines(VkCommandBuffer cmd, const gpu::VulkanContext& context, LinesPass& pass,
                  const GpuRawTractogram& tractogram, const GpuFrameTargets& frame, float line_width_px,
                  VkDeviceAddress kept_bits) {
-  // The previous frame's copy read the colour attachment: finish it before
-  // the clear overwrites it (write-after-read, an execution dependency).
-  gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COPY_BIT, 0, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, 0);
-  // The empty texel: depth 1.0, no fiber, segment and tangent 0.
-  VkClearColorValue clear{};
-  clear.uint32[0] = 0x3F800000u;  // floatBitsToUint(1.0f)
-  clear.uint32[1] = shader::kNoFiberId;
-  gpu::beginRendering(cmd, pass.color, clear, &pass.depth, 1.0f);
+  beginLineAttachments(cmd, pass.attachments);
   const uint32_t streamlines = tractogram.streamlineCount();
   if (streamlines > 0) {
     shader::LinesPush push{};
@@ -117,16 +88,7 @@ void recordLines(VkCommandBuffer cmd, const gpu::VulkanContext& context, LinesPa
       }
     }
   }
-  gpu::endRendering(cmd);
-  gpu::transitionImage(cmd, pass.color, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                       VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
-                       VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
-  // Texel rows are tightly packed in the G-buffer: 16 bytes each, the
-  // attachment's texel size.
-  VkBufferImageCopy region{};
-  region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-  region.imageExtent = {frame.width, frame.height, 1};
-  vkCmdCopyImageToBuffer(cmd, pass.color.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, frame.gbuffer.buffer, 1, &region);
+  endLineAttachmentsIntoGBuffer(cmd, pass.attachments, frame);
 }
 
 }  // namespace fibscope

@@ -1,10 +1,9 @@
 // The lines baseline (DESIGN.md section 6; the "basic OpenGL" column of the
 // paper's table 3): the uncompressed float vertices drawn as line strips
-// through the graphics pipeline, no culling, into an R32G32B32A32_UINT
-// colour attachment that holds exactly the G-buffer texel's four words
-// (shared/gbuffer.h) and a D32 depth attachment (LESS); the colour
-// attachment is then copied into GpuFrameTargets::gbuffer, so shading reads
-// the same layout whatever pipeline drew the frame.
+// through the graphics pipeline, no culling, into the line attachments
+// (line_attachments.h: the G-buffer texel's four words and a D32 depth),
+// then copied into GpuFrameTargets::gbuffer, so shading reads the same
+// layout whatever pipeline drew the frame.
 //
 // Line rasterisation is the device's (Bresenham-like "diamond exit" at
 // width 1, parallelograms or rectangles for wide lines), not the CPU
@@ -27,14 +26,14 @@
 #include "gpu/image.h"
 #include "gpu/vulkan_context.h"
 #include "render/gpu/frame_targets.h"
+#include "render/gpu/line_attachments.h"
 #include "render/gpu/raw_tractogram.h"
 
 namespace fibscope {
 
 struct LinesPass {
   gpu::GraphicsPipeline pipeline;  // lines.vert + lines.frag
-  gpu::Image color;                // R32G32B32A32_UINT, the frame's size (none until the first frame)
-  gpu::Image depth;                // D32_SFLOAT
+  LineAttachments attachments;     // none until the first frame
 };
 
 // The pipeline (attachments come with ensureLinesAttachments). Throws Error

@@ -20,23 +20,32 @@ class SetupStage final : public FrameStage {
   bool runs(const FrameContext&) const override { return true; }
 
   void record(FrameContext& frame) override {
-    const bool lines = frame.settings.pipeline == RenderPipeline::Lines;
+    const RenderPipeline pipeline = frame.settings.pipeline;
+    // The graphics pipelines draw into depth attachments of their own.
+    const bool graphics = pipeline == RenderPipeline::Lines || pipeline == RenderPipeline::Geometry ||
+                          pipeline == RenderPipeline::Tessellation;
     // Everything after reads or accumulates into these: compute passes,
-    // and the lines pipeline's vertex shader (the camera block).
-    const gpu::PassBarrier after{VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                                 VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT |
-                                     VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+    // and the graphics pipelines' shaders (the camera block; the geometry
+    // and tessellation stages only where those pipelines run: their stage
+    // bits need the device's features).
+    VkPipelineStageFlags2 readers = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT |
+                                    VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT;
+    if (pipeline == RenderPipeline::Geometry) readers |= VK_PIPELINE_STAGE_2_GEOMETRY_SHADER_BIT;
+    if (pipeline == RenderPipeline::Tessellation)
+      readers |= VK_PIPELINE_STAGE_2_TESSELLATION_CONTROL_SHADER_BIT |
+                 VK_PIPELINE_STAGE_2_TESSELLATION_EVALUATION_SHADER_BIT;
+    const gpu::PassBarrier after{VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, readers,
                                  gpu::kStorageReadWrite};
     gpu::PassScope pass(frame.cmd, frame.timer, "clear", after);
     const shader::CameraBlock block =
         makeCameraBlock(frame.camera, frame.settings.line_width_px, frameClipPlanes(frame.settings, frame.camera));
     vkCmdUpdateBuffer(frame.cmd, frame.targets.camera.buffer, 0, sizeof(block), &block);
-    if (frame.settings.pipeline == RenderPipeline::Compute) {
+    if (drawsFiblets(pipeline)) {
       const std::vector<uint32_t> words = sceneTableWords(frame.layout);
       vkCmdUpdateBuffer(frame.cmd, scene_table_.buffer, 0, words.size() * sizeof(uint32_t), words.data());
       frame.scene_table = scene_table_.address;
     }
-    if (!lines) vkCmdFillBuffer(frame.cmd, frame.targets.visibility.buffer, 0, VK_WHOLE_SIZE, 0xFFFFFFFFu);
+    if (!graphics) vkCmdFillBuffer(frame.cmd, frame.targets.visibility.buffer, 0, VK_WHOLE_SIZE, 0xFFFFFFFFu);
     // Every word 1.0f: depth 1, which no surface pass and no merge takes
     // (shared/gbuffer.h: SurfaceTexel).
     if (frame.surfaces)
