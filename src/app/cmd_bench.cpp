@@ -1,11 +1,15 @@
 // `fibscope bench [FILE] [--pipeline P] [--culling C] [--compare P[/C],...]
-// [--frames N] [--step DEG] [--size WxH] [--json]`: the fiblets paper's
+// [--frames N] [--step DEG] [--size WxH] [--count-missed] [--json]`: the fiblets paper's
 // frame benchmark (section 5): 1920x1080, the camera orbiting the
 // tractogram at 1.14 degrees per frame for a full turn (316 frames), GPU
 // timestamps around every pass. Prints mean / median / p95 frame time, the
 // time of each pass, the fraction of fiblets drawn and segments drawn per
 // millisecond; with --compare, several pipelines draw the same frames in one
 // run (frame by frame, in turn) and their ratios to the first are printed.
+// --count-missed also draws every measured frame with culling off (untimed)
+// and counts, per culled compute variant, the pixels covered there but not
+// in its frame: zero for the conservative modes, the artifact of the
+// coverage buffer (CullingMode::Coverage, paper figure 9).
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
@@ -39,6 +43,7 @@ struct BenchOptions {
   double elevation_deg = 0;
   double distance = 0;  // 0: the closest that frames the box at every azimuth
   uint32_t warmup = 2;
+  bool count_missed = false;
   bool json = false;
 };
 
@@ -49,7 +54,16 @@ struct Variant {
   std::map<std::string, double> pass_ms_sum;
   std::vector<std::string> pass_order;
   uint64_t segments_drawn_sum = 0;
+  std::vector<uint64_t> missed_pixels;  // --count-missed: per measured frame
 };
+
+// Pixels the reference keys cover that `keys` leave empty.
+uint64_t missedPixels(const std::vector<uint64_t>& reference, const std::vector<uint64_t>& keys) {
+  uint64_t missed = 0;
+  for (size_t i = 0; i < reference.size() && i < keys.size(); ++i)
+    missed += reference[i] != ~uint64_t(0) && keys[i] == ~uint64_t(0);
+  return missed;
+}
 
 std::vector<Variant> variantsFrom(const BenchOptions& o) {
   const RenderSettings base = renderSettingsFrom(o.render);
@@ -131,6 +145,22 @@ void runBench(const BenchOptions& o) {
   // visibility, which must be its own.
   std::vector<std::unique_ptr<FrameRenderer>> renderers;
   for (size_t i = 0; i < variants.size(); ++i) renderers.push_back(std::make_unique<FrameRenderer>(*context, width, height));
+  // --count-missed: the unculled frame each culled compute variant is
+  // compared with (the first compute variant's settings, culling off).
+  std::unique_ptr<FrameRenderer> reference;
+  RenderSettings reference_settings;
+  GpuScene reference_scene = gpu_scene;
+  if (o.count_missed) {
+    const auto compute = std::find_if(variants.begin(), variants.end(), [](const Variant& v) {
+      return v.settings.pipeline == RenderPipeline::Compute;
+    });
+    if (compute == variants.end()) throw Error("--count-missed: no compute variant to count missed pixels of");
+    reference_settings = compute->settings;
+    reference_settings.culling = CullingMode::None;
+    filter.apply(reference_scene, RenderPipeline::Compute);
+    reference = std::make_unique<FrameRenderer>(*context, width, height);
+  }
+  uint64_t reference_covered = 0;
 
   nlohmann::json out;
   // A constant distance for the whole orbit: the farthest of the snug fits
@@ -154,12 +184,21 @@ void runBench(const BenchOptions& o) {
     const double azimuth = o.step_deg * double(frame < o.warmup ? 0 : frame - o.warmup);
     const Camera camera =
         withAnatomyInView(orbitCamera(scene.bounds, azimuth, o.elevation_deg, width, height, distance), anatomy);
+    std::vector<uint64_t> reference_keys;
+    if (reference && frame >= o.warmup) {
+      reference->render(camera, reference_settings, reference_scene);
+      reference_keys = downloadVisibility(*context, reference->targets());
+      for (uint64_t key : reference_keys) reference_covered += key != ~uint64_t(0);
+    }
     for (size_t i = 0; i < variants.size(); ++i) {
       Variant& v = variants[i];
       const auto t0 = std::chrono::steady_clock::now();
       const FrameStats stats = renderers[i]->render(camera, v.settings, variant_scenes[i]);
       const double wall = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
       if (frame < o.warmup) continue;
+      if (!reference_keys.empty() && v.settings.pipeline == RenderPipeline::Compute &&
+          v.settings.culling != CullingMode::None)
+        v.missed_pixels.push_back(missedPixels(reference_keys, downloadVisibility(*context, renderers[i]->targets())));
       v.gpu_ms.push_back(stats.gpu_ms);
       v.wall_ms.push_back(wall);
       const double total_fiblets = double(std::max<uint64_t>(stats.fiblets_total, 1));
@@ -179,6 +218,7 @@ void runBench(const BenchOptions& o) {
     }
   }
   checkValidation(*context, o.render);
+  if (o.count_missed) out["reference_covered_pixels"] = reference_covered;  // summed over the measured frames
 
   out["input"] = scene.name;
   out["device"] = context->info().name;
@@ -234,6 +274,16 @@ void runBench(const BenchOptions& o) {
     j["wall_median_ms"] = percentile(v.wall_ms, 50);
     j["median_ratio_to_first"] = base_median > 0 ? ratioTime(v) / base_median : 0.0;
     for (const std::string& name : v.pass_order) j["pass_mean_ms"][name] = v.pass_ms_sum[name] / double(o.frames);
+    uint64_t missed_total = 0, missed_max = 0;
+    for (uint64_t m : v.missed_pixels) {
+      missed_total += m;
+      missed_max = std::max(missed_max, m);
+    }
+    if (!v.missed_pixels.empty()) {
+      j["missed_pixels"] = v.missed_pixels;
+      j["missed_pixels_total"] = missed_total;
+      j["missed_pixels_max"] = missed_max;
+    }
     if (!o.json) {
       std::printf("%-20s %10.3f %10.3f %10.3f %10.3f", v.label.c_str(), mean(v.gpu_ms), median,
                   percentile(v.gpu_ms, 95), mean(v.wall_ms));
@@ -245,6 +295,10 @@ void runBench(const BenchOptions& o) {
       std::printf("\n    passes:");
       for (const std::string& name : v.pass_order) std::printf(" %s %.3f", name.c_str(), v.pass_ms_sum[name] / double(o.frames));
       std::printf(" (mean ms)\n");
+      if (!v.missed_pixels.empty())
+        std::printf("    missed pixels (covered with culling off, not here): %llu in %zu frames, at most %llu in one\n",
+                    static_cast<unsigned long long>(missed_total), v.missed_pixels.size(),
+                    static_cast<unsigned long long>(missed_max));
     }
     out["results"].push_back(j);
   }
@@ -258,13 +312,16 @@ void addBenchCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("bench", "Frame benchmark: the camera orbits the tractogram (fiblets paper protocol)");
   addRenderCliOptions(cmd, o->render);
   cmd->add_option("--compare", o->compare,
-                  "Pipelines drawn on the same frames, e.g. compute/two-phase,compute/none,lines,raw-compute; ratios "
+                  "Pipelines drawn on the same frames, e.g. compute/two-phase,compute/coverage,compute/none,lines; ratios "
                   "are to the first");
   cmd->add_option("--frames", o->frames, "Measured frames")->capture_default_str();
   cmd->add_option("--step", o->step_deg, "Orbit step per frame, degrees")->capture_default_str();
   cmd->add_option("--elevation", o->elevation_deg, "Orbit elevation, degrees")->capture_default_str();
   cmd->add_option("--distance", o->distance, "Camera distance factor (1: the bounding sphere fits; 0: as close as frames the tractogram all around)")->capture_default_str();
   cmd->add_option("--warmup", o->warmup, "Unmeasured frames first")->capture_default_str();
+  cmd->add_flag("--count-missed", o->count_missed,
+                "Also draw each measured frame with culling off (untimed) and count the pixels each culled compute "
+                "variant misses (JSON: missed_pixels per frame and missed_pixels_total)");
   cmd->add_flag("--json", o->json, "Print the results as JSON");
   cmd->callback([o] { runBench(*o); });
 }

@@ -24,6 +24,9 @@ enum class CullingMode : uint8_t {
   None,      // every fiblet is drawn, no LoD
   Frustum,   // dilated frustum (paper eq. 5) and far-view LoD
   TwoPhase,  // Frustum + conservative two-phase occlusion culling
+  // Frustum + the paper's coverage buffer (the previous frame's depth
+  // re-projected; one pass, NOT conservative: shaders/shared/coverage_push.h)
+  Coverage,
 };
 
 enum class ColorMode : uint8_t {
@@ -68,7 +71,7 @@ enum class Lighting : uint8_t {
 struct RenderSettings {
   RenderPipeline pipeline = RenderPipeline::Compute;
   CullingMode culling = CullingMode::TwoPhase;
-  float lod_pixels = 4.0f;  // far-view LoD below this projected fiblet size (Frustum, TwoPhase)
+  float lod_pixels = 4.0f;  // far-view LoD below this projected fiblet size (Frustum, TwoPhase, Coverage)
   float line_width_px = 1.0f;  // [1, 4]
   ColorMode color = ColorMode::Orientation;
   std::array<float, 3> solid_color = {0.9f, 0.9f, 0.85f};

@@ -93,14 +93,14 @@ std::vector<SettingInfo> makeTable() {
                      [](int v) { return renderPipelineName(RenderPipeline(v)); },
                      getChoice<RenderPipeline, &RenderSettings::pipeline>,
                      setChoice<RenderPipeline, &RenderSettings::pipeline>));
-  t.push_back(with(choice("culling", "culling", "none | frustum | two-phase (compute pipeline)", 3,
+  t.push_back(with(choice("culling", "culling", "none | frustum | two-phase | coverage (compute pipeline)", 4,
                           [](int v) { return cullingModeName(CullingMode(v)); },
                           getChoice<CullingMode, &RenderSettings::culling>,
                           setChoice<CullingMode, &RenderSettings::culling>),
                    isCompute));
   t.push_back(with(number("lod-pixels", "LoD below",
                           "Far-view LoD: fiblets whose bounding sphere projects smaller are drawn as one segment "
-                          "(frustum and two-phase culling; 0: off)",
+                          "(frustum, two-phase and coverage culling; 0: off)",
                           &RenderSettings::lod_pixels, 0, 4096, "px"),
                    isCulled));
   SettingInfo width = number("line-width", "line width", "Line width in pixels", &RenderSettings::line_width_px,
