@@ -7,8 +7,8 @@
 // millisecond; with --compare, several pipelines draw the same frames in one
 // run (frame by frame, in turn) and their ratios to the first are printed.
 // --count-missed also draws every measured frame with culling off (untimed)
-// and counts, per culled compute variant, the pixels covered there but not
-// in its frame: zero for the conservative modes, the artifact of the
+// and counts, per occlusion-culled compute variant, the pixels covered
+// there but not in its frame: zero for two-phase, the artifact of the
 // coverage buffer (CullingMode::Coverage, paper figure 9).
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -17,6 +17,7 @@
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <numeric>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -54,15 +55,20 @@ struct Variant {
   std::map<std::string, double> pass_ms_sum;
   std::vector<std::string> pass_order;
   uint64_t segments_drawn_sum = 0;
-  std::vector<uint64_t> missed_pixels;  // --count-missed: per measured frame
+  std::vector<uint64_t> missed_pixels;   // --count-missed: per measured frame
+  std::vector<uint64_t> changed_pixels;  // ... and keys that differ at all (another fiber shows)
 };
 
-// Pixels the reference keys cover that `keys` leave empty.
-uint64_t missedPixels(const std::vector<uint64_t>& reference, const std::vector<uint64_t>& keys) {
-  uint64_t missed = 0;
-  for (size_t i = 0; i < reference.size() && i < keys.size(); ++i)
+// Pixels the reference keys cover that `keys` leave empty, and pixels whose
+// keys differ at all.
+void countMissed(const std::vector<uint64_t>& reference, const std::vector<uint64_t>& keys, Variant& v) {
+  uint64_t missed = 0, changed = 0;
+  for (size_t i = 0; i < reference.size() && i < keys.size(); ++i) {
     missed += reference[i] != ~uint64_t(0) && keys[i] == ~uint64_t(0);
-  return missed;
+    changed += reference[i] != keys[i];
+  }
+  v.missed_pixels.push_back(missed);
+  v.changed_pixels.push_back(changed);
 }
 
 std::vector<Variant> variantsFrom(const BenchOptions& o) {
@@ -147,6 +153,10 @@ void runBench(const BenchOptions& o) {
   for (size_t i = 0; i < variants.size(); ++i) renderers.push_back(std::make_unique<FrameRenderer>(*context, width, height));
   // --count-missed: the unculled frame each culled compute variant is
   // compared with (the first compute variant's settings, culling off).
+  // With LoD on, frustum culling with the same LoD instead: culling off
+  // has no LoD, and the LoD's segments would count as misses. Frustum
+  // culling keeps every fiblet in view, so it draws culling off's frame
+  // (bit for bit without LoD: gpu_culling_test.cpp) with the variants' LoD.
   std::unique_ptr<FrameRenderer> reference;
   RenderSettings reference_settings;
   GpuScene reference_scene = gpu_scene;
@@ -156,7 +166,7 @@ void runBench(const BenchOptions& o) {
     });
     if (compute == variants.end()) throw Error("--count-missed: no compute variant to count missed pixels of");
     reference_settings = compute->settings;
-    reference_settings.culling = CullingMode::None;
+    reference_settings.culling = reference_settings.lod_pixels > 0 ? CullingMode::Frustum : CullingMode::None;
     filter.apply(reference_scene, RenderPipeline::Compute);
     reference = std::make_unique<FrameRenderer>(*context, width, height);
   }
@@ -197,8 +207,8 @@ void runBench(const BenchOptions& o) {
       const double wall = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
       if (frame < o.warmup) continue;
       if (!reference_keys.empty() && v.settings.pipeline == RenderPipeline::Compute &&
-          v.settings.culling != CullingMode::None)
-        v.missed_pixels.push_back(missedPixels(reference_keys, downloadVisibility(*context, renderers[i]->targets())));
+          v.settings.culling != CullingMode::None && v.settings.culling != CullingMode::Frustum)
+        countMissed(reference_keys, downloadVisibility(*context, renderers[i]->targets()), v);
       v.gpu_ms.push_back(stats.gpu_ms);
       v.wall_ms.push_back(wall);
       const double total_fiblets = double(std::max<uint64_t>(stats.fiblets_total, 1));
@@ -218,7 +228,10 @@ void runBench(const BenchOptions& o) {
     }
   }
   checkValidation(*context, o.render);
-  if (o.count_missed) out["reference_covered_pixels"] = reference_covered;  // summed over the measured frames
+  if (o.count_missed) {
+    out["reference_covered_pixels"] = reference_covered;  // summed over the measured frames
+    out["missed_reference"] = "compute/" + std::string(cullingModeName(reference_settings.culling));
+  }
 
   out["input"] = scene.name;
   out["device"] = context->info().name;
@@ -283,6 +296,10 @@ void runBench(const BenchOptions& o) {
       j["missed_pixels"] = v.missed_pixels;
       j["missed_pixels_total"] = missed_total;
       j["missed_pixels_max"] = missed_max;
+      uint64_t changed_total = 0;
+      for (uint64_t c : v.changed_pixels) changed_total += c;
+      j["changed_pixels"] = v.changed_pixels;
+      j["changed_pixels_total"] = changed_total;
     }
     if (!o.json) {
       std::printf("%-20s %10.3f %10.3f %10.3f %10.3f", v.label.c_str(), mean(v.gpu_ms), median,
@@ -296,9 +313,12 @@ void runBench(const BenchOptions& o) {
       for (const std::string& name : v.pass_order) std::printf(" %s %.3f", name.c_str(), v.pass_ms_sum[name] / double(o.frames));
       std::printf(" (mean ms)\n");
       if (!v.missed_pixels.empty())
-        std::printf("    missed pixels (covered with culling off, not here): %llu in %zu frames, at most %llu in one\n",
+        std::printf("    missed pixels (covered by compute/%s, not here): %llu in %zu frames, at most %llu in one; "
+                    "%llu pixels changed\n",
+                    std::string(cullingModeName(reference_settings.culling)).c_str(),
                     static_cast<unsigned long long>(missed_total), v.missed_pixels.size(),
-                    static_cast<unsigned long long>(missed_max));
+                    static_cast<unsigned long long>(missed_max),
+                    static_cast<unsigned long long>(std::accumulate(v.changed_pixels.begin(), v.changed_pixels.end(), uint64_t(0))));
     }
     out["results"].push_back(j);
   }
@@ -320,8 +340,9 @@ void addBenchCommand(CLI::App& app) {
   cmd->add_option("--distance", o->distance, "Camera distance factor (1: the bounding sphere fits; 0: as close as frames the tractogram all around)")->capture_default_str();
   cmd->add_option("--warmup", o->warmup, "Unmeasured frames first")->capture_default_str();
   cmd->add_flag("--count-missed", o->count_missed,
-                "Also draw each measured frame with culling off (untimed) and count the pixels each culled compute "
-                "variant misses (JSON: missed_pixels per frame and missed_pixels_total)");
+                "Also draw each measured frame with culling off (frustum culling with the same LoD when LoD is on; "
+                "untimed) and count the pixels each occlusion-culled compute variant misses (JSON: missed_pixels "
+                "per frame, missed_pixels_total)");
   cmd->add_flag("--json", o->json, "Print the results as JSON");
   cmd->callback([o] { runBench(*o); });
 }

@@ -44,12 +44,12 @@ RenderSettings plainSettings(CullingMode culling, float line_width) {
   return settings;
 }
 
-glm::dmat4 viewProjection(const Camera& camera) { return glm::make_mat4(viewProjectionD(camera).data()); }
+glm::dmat4 viewProjectionGlm(const Camera& camera) { return glm::make_mat4(viewProjectionD(camera).data()); }
 
 // The world size of one pixel at view depth z, measured: two adjacent pixel
 // centres unprojected at that depth.
 double pixelWorldSize(const Camera& camera, double z) {
-  const glm::dmat4 inverse = glm::inverse(viewProjection(camera));
+  const glm::dmat4 inverse = glm::inverse(viewProjectionGlm(camera));
   const glm::dmat4 projection = glm::make_mat4(projectionMatrixD(camera).data());
   // NDC depth of view depth z on the axis.
   const glm::dvec4 clip = projection * glm::dvec4(0, 0, -z, 1);
@@ -85,7 +85,7 @@ struct Splat {
 };
 
 Splat referenceSplat(const Camera& previous, const Camera& next, uint32_t px, uint32_t py, float depth) {
-  const glm::dvec4 h = glm::inverse(viewProjection(previous)) *
+  const glm::dvec4 h = glm::inverse(viewProjectionGlm(previous)) *
                        glm::dvec4((px + 0.5) / previous.width * 2 - 1, (py + 0.5) / previous.height * 2 - 1, depth, 1);
   const glm::dvec3 world = glm::dvec3(h) / h.w;
   // R_S(z): half a pixel diagonal of the previous frame at the sample's view depth.
@@ -94,7 +94,7 @@ Splat referenceSplat(const Camera& previous, const Camera& next, uint32_t px, ui
       glm::dvec3(previous.target[0], previous.target[1], previous.target[2]) - eye_prev);
   const double z_prev = glm::dot(world - eye_prev, axis_prev);
   const double radius = std::sqrt(0.5) * pixelWorldSize(previous, z_prev);
-  const glm::dmat4 vp = viewProjection(next);
+  const glm::dmat4 vp = viewProjectionGlm(next);
   const glm::dvec4 c = vp * glm::dvec4(world, 1);
   const glm::dvec3 eye(next.eye[0], next.eye[1], next.eye[2]);
   const glm::dvec4 b = vp * glm::dvec4(world + radius * glm::normalize(world - eye), 1);
@@ -130,6 +130,7 @@ class GpuCoverage : public test::GpuTest {
   // history), and the fraction of fiblets `mode` drew.
   struct Orbit {
     std::vector<uint64_t> missed;
+    std::vector<uint64_t> changed;  // keys that differ at all: another fiber (or none) shows
     std::vector<double> drawn;
     uint64_t covered = 0;  // by the reference, over the frames
     uint64_t total() const { return std::accumulate(missed.begin(), missed.end(), uint64_t(0)); }
@@ -143,12 +144,14 @@ class GpuCoverage : public test::GpuTest {
       const FrameStats stats = culled.render(camera, plainSettings(mode, width), scene());
       const auto a = downloadVisibility(context(), reference.targets());
       const auto b = downloadVisibility(context(), culled.targets());
-      uint64_t missed = 0;
+      uint64_t missed = 0, changed = 0;
       for (size_t i = 0; i < a.size(); ++i) {
         orbit_result.covered += a[i] != kEmpty;
         missed += a[i] != kEmpty && b[i] == kEmpty;
+        changed += a[i] != b[i];
       }
       orbit_result.missed.push_back(missed);
+      orbit_result.changed.push_back(changed);
       orbit_result.drawn.push_back(double(stats.fiblets_drawn) / double(std::max<uint64_t>(stats.fiblets_total, 1)));
     }
     return orbit_result;
@@ -171,7 +174,7 @@ TEST_F(GpuCoverage, reprojectionMatchesACpuReference) {
   const glm::dvec3 centre = 0.5 * (glm::dvec3(bounds_.min[0], bounds_.min[1], bounds_.min[2]) +
                                    glm::dvec3(bounds_.max[0], bounds_.max[1], bounds_.max[2]));
   const glm::dvec3 extent = glm::dvec3(bounds_.max[0], bounds_.max[1], bounds_.max[2]) - centre;
-  const glm::dmat4 vp = viewProjection(previous);
+  const glm::dmat4 vp = viewProjectionGlm(previous);
   std::vector<uint64_t> keys(shader::visibilityKeyCount(kWidth, kHeight), kEmpty);
   std::vector<Splat> splats;
   for (int i = 0; i < 12; ++i) {
@@ -273,8 +276,10 @@ TEST_F(GpuCoverage, missedPixelsOfAnOrbitBesideTwoPhase) {
     std::printf("%-22s missed pixels per frame:", name);
     for (uint64_t m : o.missed) std::printf(" %llu", static_cast<unsigned long long>(m));
     const double drawn = std::accumulate(o.drawn.begin() + 1, o.drawn.end(), 0.0) / double(o.drawn.size() - 1);
-    std::printf("  (total %llu of %llu covered; fiblets drawn after the first frame %.3f)\n",
-                static_cast<unsigned long long>(o.total()), static_cast<unsigned long long>(o.covered), drawn);
+    const uint64_t changed = std::accumulate(o.changed.begin(), o.changed.end(), uint64_t(0));
+    std::printf("  (total %llu of %llu covered, %llu keys changed; fiblets drawn after the first frame %.3f)\n",
+                static_cast<unsigned long long>(o.total()), static_cast<unsigned long long>(o.covered),
+                static_cast<unsigned long long>(changed), drawn);
   };
   print("two-phase, 1.14 deg:", two_small);
   print("two-phase, 60 deg:", two_large);
@@ -282,6 +287,8 @@ TEST_F(GpuCoverage, missedPixelsOfAnOrbitBesideTwoPhase) {
   print("coverage, 60 deg:", cov_large);
   EXPECT_EQ(two_small.total(), 0u) << "two-phase is conservative";
   EXPECT_EQ(two_large.total(), 0u) << "two-phase is conservative";
+  for (const Orbit* o : {&two_small, &two_large})
+    EXPECT_EQ(std::accumulate(o->changed.begin(), o->changed.end(), uint64_t(0)), 0u) << "bit for bit";
   EXPECT_EQ(cov_small.missed[0], 0u) << "the first frame has no history: frustum culling only";
   EXPECT_EQ(cov_large.missed[0], 0u);
   // Larger steps uncover more of what the previous frame hid.
