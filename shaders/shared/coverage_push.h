@@ -38,7 +38,13 @@
 // passes the test, and the frame equals the unculled one (tested). A
 // larger radius would spread near fibers' depths over the gaps beside
 // them and cull the fibers seen through those gaps even with the camera
-// still. Splats are capped at kCoverageMaxSplatPixels (a sample very close
+// still. The price, measured (docs/BENCHMARKS.md): once the camera moves,
+// the parallax between fibers at different depths opens gaps that no
+// sample of frame N covers, the max over a fiblet's rectangle meets one,
+// and little is culled (99 % of the fiblets drawn at 1.14 degree steps,
+// against two-phase's 93 %). A radius of several pixels would fill those
+// gaps, cull more and miss more (the paper's figure 9); it is one
+// constant here. Splats are capped at kCoverageMaxSplatPixels (a sample very close
 // to the new eye would otherwise cover a large disc: fewer pixels covered
 // only means less culling, never an error).
 #ifndef FIBSCOPE_SHADERS_SHARED_COVERAGE_PUSH_H

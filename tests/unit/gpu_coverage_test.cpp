@@ -291,8 +291,12 @@ TEST_F(GpuCoverage, missedPixelsOfAnOrbitBesideTwoPhase) {
     EXPECT_EQ(std::accumulate(o->changed.begin(), o->changed.end(), uint64_t(0)), 0u) << "bit for bit";
   EXPECT_EQ(cov_small.missed[0], 0u) << "the first frame has no history: frustum culling only";
   EXPECT_EQ(cov_large.missed[0], 0u);
-  // Larger steps uncover more of what the previous frame hid.
-  EXPECT_GE(cov_large.total(), cov_small.total());
+  // Not asserted: that 60-degree steps miss more than 1.14-degree ones. It
+  // does not hold robustly: a large step re-projects the last frame's
+  // samples so sparsely that the pyramid's max over a fiblet's rectangle
+  // nearly always meets an uncovered pixel and little is culled at all
+  // (99 % drawn here, 99.4 % in docs/BENCHMARKS.md, where 1.14 degrees
+  // missed 3 pixels and 60 none).
 }
 
 }  // namespace
