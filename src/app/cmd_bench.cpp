@@ -324,7 +324,8 @@ void runBench(const BenchOptions& o) {
                     std::string(cullingModeName(reference_settings.culling)).c_str(),
                     static_cast<unsigned long long>(missed_total), v.missed_pixels.size(),
                     static_cast<unsigned long long>(missed_max),
-                    static_cast<unsigned long long>(std::accumulate(v.changed_pixels.begin(), v.changed_pixels.end(), uint64_t(0))));
+                    static_cast<unsigned long long>(
+                        std::accumulate(v.changed_pixels.begin(), v.changed_pixels.end(), uint64_t(0))));
     }
     out["results"].push_back(j);
   }
@@ -338,8 +339,8 @@ void addBenchCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("bench", "Frame benchmark: the camera orbits the tractogram (fiblets paper protocol)");
   addRenderCliOptions(cmd, o->render);
   cmd->add_option("--compare", o->compare,
-                  "Pipelines drawn on the same frames, e.g. compute/two-phase,compute/coverage,compute/none,lines; ratios "
-                  "are to the first");
+                  "Pipelines drawn on the same frames, e.g. compute/two-phase,compute/coverage,compute/none,lines; "
+                  "ratios are to the first");
   cmd->add_option("--frames", o->frames, "Measured frames")->capture_default_str();
   cmd->add_option("--step", o->step_deg, "Orbit step per frame, degrees")->capture_default_str();
   cmd->add_option("--elevation", o->elevation_deg, "Orbit elevation, degrees")->capture_default_str();

@@ -90,8 +90,8 @@ Splat referenceSplat(const Camera& previous, const Camera& next, uint32_t px, ui
   const glm::dvec3 world = glm::dvec3(h) / h.w;
   // R_S(z): half a pixel diagonal of the previous frame at the sample's view depth.
   const glm::dvec3 eye_prev(previous.eye[0], previous.eye[1], previous.eye[2]);
-  const glm::dvec3 axis_prev = glm::normalize(
-      glm::dvec3(previous.target[0], previous.target[1], previous.target[2]) - eye_prev);
+  const glm::dvec3 axis_prev =
+      glm::normalize(glm::dvec3(previous.target[0], previous.target[1], previous.target[2]) - eye_prev);
   const double z_prev = glm::dot(world - eye_prev, axis_prev);
   const double radius = std::sqrt(0.5) * pixelWorldSize(previous, z_prev);
   const glm::dmat4 vp = viewProjectionGlm(next);
@@ -178,7 +178,8 @@ TEST_F(GpuCoverage, reprojectionMatchesACpuReference) {
   std::vector<uint64_t> keys(shader::visibilityKeyCount(kWidth, kHeight), kEmpty);
   std::vector<Splat> splats;
   for (int i = 0; i < 12; ++i) {
-    const glm::dvec3 p = centre + extent * glm::dvec3(0.3 * std::sin(1.7 * i), 0.3 * std::cos(2.3 * i), 0.3 * std::sin(0.9 * i + 1));
+    const glm::dvec3 p =
+        centre + extent * glm::dvec3(0.3 * std::sin(1.7 * i), 0.3 * std::cos(2.3 * i), 0.3 * std::sin(0.9 * i + 1));
     const glm::dvec4 c = vp * glm::dvec4(p, 1);
     const uint32_t px = uint32_t((c.x / c.w + 1) * 0.5 * kWidth), py = uint32_t((c.y / c.w + 1) * 0.5 * kHeight);
     const float depth = float(c.z / c.w);

@@ -46,9 +46,8 @@ float coverageSplatRadiusMm(const Camera& camera, float view_depth_mm) {
   return shader::coverageSplatRadius(view_depth_mm, focalPixels(camera));
 }
 
-void recordCoverageReproject(VkCommandBuffer cmd, const gpu::ComputePipeline& pipeline,
-                             const CoverageHistory& history, const Camera& camera, const GpuFrameTargets& frame,
-                             VkDeviceAddress coverage) {
+void recordCoverageReproject(VkCommandBuffer cmd, const gpu::ComputePipeline& pipeline, const CoverageHistory& history,
+                             const Camera& camera, const GpuFrameTargets& frame, VkDeviceAddress coverage) {
   const std::array<double, 16> vp = viewProjectionD(history.camera);
   const glm::dmat4 inverse = glm::inverse(glm::make_mat4(vp.data()));  // column-major, as Mat4
   shader::CoverageReprojectPush push{};

@@ -49,8 +49,7 @@ float coverageSplatRadiusMm(const Camera& camera, float view_depth_mm);
 // kCoverageFarBits and made visible to compute; frame.camera holds the new
 // camera `camera`, visible to compute. The caller places the barrier after.
 // Both frames are frame.width x frame.height.
-void recordCoverageReproject(VkCommandBuffer cmd, const gpu::ComputePipeline& pipeline,
-                             const CoverageHistory& history, const Camera& camera, const GpuFrameTargets& frame,
-                             VkDeviceAddress coverage);
+void recordCoverageReproject(VkCommandBuffer cmd, const gpu::ComputePipeline& pipeline, const CoverageHistory& history,
+                             const Camera& camera, const GpuFrameTargets& frame, VkDeviceAddress coverage);
 
 }  // namespace fibscope

@@ -311,7 +311,8 @@ void recordCulledRaster(VkCommandBuffer cmd, const gpu::VulkanContext& context, 
     // next frame's re-projection; its compute reads after this copy.
     const VkBufferCopy region{0, 0, buffers.coverage.previous_keys.size};
     vkCmdCopyBuffer(cmd, frame.visibility.buffer, buffers.coverage.previous_keys.buffer, 1, &region);
-    gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT | VK_ACCESS_2_TRANSFER_READ_BIT,
+    gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT,
+                       VK_ACCESS_2_TRANSFER_WRITE_BIT | VK_ACCESS_2_TRANSFER_READ_BIT,
                        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_TRANSFER_BIT,
                        gpu::kStorageReadWrite | VK_ACCESS_2_TRANSFER_WRITE_BIT);
     buffers.coverage.camera = cull.camera;
