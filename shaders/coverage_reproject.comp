@@ -48,7 +48,7 @@ void main() {
   const vec3 world = h.xyz / h.w;
   // N's clip w of the sample is 1 / h.w (clip = (ndc, 1) * w and the
   // inverse maps clip to homogeneous world with w_world = 1).
-  const float radius = coverageSplatRadius(1.0 / h.w, pc.previous_focal_px);
+  const float radius = coverageSplatRadius(1.0 / h.w, pc.previous_focal_px, pc.splat_pixels);
 
   const CameraBlock cam = CameraRef(pc.camera).camera;
   const vec4 centre = cameraTransformPoint(cam.view_projection, world);

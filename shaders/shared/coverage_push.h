@@ -43,8 +43,8 @@
 // sample of frame N covers, the max over a fiblet's rectangle meets one,
 // and little is culled (99 % of the fiblets drawn at 1.14 degree steps,
 // against two-phase's 93 %). A radius of several pixels would fill those
-// gaps, cull more and miss more (the paper's figure 9); it is one
-// constant here. Splats are capped at kCoverageMaxSplatPixels (a sample very close
+// gaps, cull more and miss more (the paper's figure 9): the setting
+// "coverage-splat" chooses k. Splats are capped at kCoverageMaxSplatPixels (a sample very close
 // to the new eye would otherwise cover a large disc: fewer pixels covered
 // only means less culling, never an error).
 #ifndef FIBSCOPE_SHADERS_SHARED_COVERAGE_PUSH_H
@@ -64,6 +64,8 @@
 
 SHADER_NAMESPACE_BEGIN
 
+// The default of RenderSettings::coverage_splat_px (the setting
+// "coverage-splat" chooses another k).
 COVERAGE_CONST float kCoverageSplatPixels = 0.70710678f;  // sqrt(2) / 2: half a pixel's diagonal
 COVERAGE_CONST float kCoverageMaxSplatPixels = 4.0f;      // disc radius cap in new-frame pixels
 // floatBitsToUint(1.0): the cleared coverage (far plane, nothing occludes).
@@ -80,14 +82,14 @@ struct CoverageReprojectPush {
   uint height;
   float previous_focal_px;  // |P[1][1]| * height / 2 of frame N
   float focal_px;           // the same for the new frame
-  uint pad0;                // to a multiple of 16 bytes, as std430 sizes the struct
-  uint pad1;
+  float splat_pixels;       // k of R_S(z) (RenderSettings::coverage_splat_px)
+  uint pad;                 // to a multiple of 16 bytes, as std430 sizes the struct
 };
 
 // R_S(z): the world radius of the hemisphere around a sample at view depth
-// `view_depth_mm` of frame N (see above).
-SHADER_FN float coverageSplatRadius(float view_depth_mm, float previous_focal_px) {
-  return kCoverageSplatPixels * view_depth_mm / previous_focal_px;
+// `view_depth_mm` of frame N, `splat_pixels` (k) of its pixels (see above).
+SHADER_FN float coverageSplatRadius(float view_depth_mm, float previous_focal_px, float splat_pixels) {
+  return splat_pixels * view_depth_mm / previous_focal_px;
 }
 
 SHADER_NAMESPACE_END

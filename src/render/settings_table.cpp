@@ -80,6 +80,7 @@ constexpr double kMaxSliceCoordinate = 1e6;
 
 bool isCompute(const RenderSettings& s) { return s.pipeline == RenderPipeline::Compute; }
 bool isCulled(const RenderSettings& s) { return isCompute(s) && s.culling != CullingMode::None; }
+bool isCoverage(const RenderSettings& s) { return isCompute(s) && s.culling == CullingMode::Coverage; }
 bool isSolid(const RenderSettings& s) { return s.color == ColorMode::Solid; }
 bool isScalar(const RenderSettings& s) { return s.color == ColorMode::Scalar; }
 bool isLit(const RenderSettings& s) { return s.lighting == Lighting::IlluminatedLines; }
@@ -103,6 +104,11 @@ std::vector<SettingInfo> makeTable() {
                           "(frustum, two-phase and coverage culling; 0: off)",
                           &RenderSettings::lod_pixels, 0, 4096, "px"),
                    isCulled));
+  t.push_back(with(number("coverage-splat", "coverage splat",
+                          "Coverage culling: the radius of each re-projected sample's hemisphere in previous-frame "
+                          "pixels (0.71: exact with the camera still; larger culls more and misses more)",
+                          &RenderSettings::coverage_splat_px, 0.5f, 8, "px"),
+                   isCoverage));
   SettingInfo width = number("line-width", "line width", "Line width in pixels", &RenderSettings::line_width_px,
                              kMinLineWidth, kMaxLineWidth, "px");
   width.alias = "width";

@@ -42,12 +42,13 @@ void destroyCoverageHistory(const gpu::VulkanContext& context, CoverageHistory& 
   history = CoverageHistory{};
 }
 
-float coverageSplatRadiusMm(const Camera& camera, float view_depth_mm) {
-  return shader::coverageSplatRadius(view_depth_mm, focalPixels(camera));
+float coverageSplatRadiusMm(const Camera& camera, float view_depth_mm, float splat_pixels) {
+  return shader::coverageSplatRadius(view_depth_mm, focalPixels(camera), splat_pixels);
 }
 
 void recordCoverageReproject(VkCommandBuffer cmd, const gpu::ComputePipeline& pipeline, const CoverageHistory& history,
-                             const Camera& camera, const GpuFrameTargets& frame, VkDeviceAddress coverage) {
+                             const Camera& camera, const GpuFrameTargets& frame, VkDeviceAddress coverage,
+                             float splat_pixels) {
   const std::array<double, 16> vp = viewProjectionD(history.camera);
   const glm::dmat4 inverse = glm::inverse(glm::make_mat4(vp.data()));  // column-major, as Mat4
   shader::CoverageReprojectPush push{};
@@ -61,6 +62,7 @@ void recordCoverageReproject(VkCommandBuffer cmd, const gpu::ComputePipeline& pi
   push.height = frame.height;
   push.previous_focal_px = focalPixels(history.camera);
   push.focal_px = focalPixels(camera);
+  push.splat_pixels = splat_pixels;
   gpu::recordDispatch(cmd, pipeline, push, shader::pixelGroups(frame.width), shader::pixelGroups(frame.height));
 }
 

@@ -17,6 +17,7 @@
 #include "render/camera.h"
 #include "render/gpu/frame_targets.h"
 #include "render/gpu/scene_table.h"
+#include "shared/coverage_push.h"
 
 namespace fibscope {
 
@@ -41,15 +42,18 @@ void prepareCoverageHistory(const gpu::VulkanContext& context, CoverageHistory& 
 void destroyCoverageHistory(const gpu::VulkanContext& context, CoverageHistory& history);
 
 // The world radius R_S of a sample at view depth `view_depth_mm` of a frame
-// seen by `camera` (shared/coverage_push.h: coverageSplatRadius).
-float coverageSplatRadiusMm(const Camera& camera, float view_depth_mm);
+// seen by `camera`, `splat_pixels` of its pixels (shared/coverage_push.h:
+// coverageSplatRadius).
+float coverageSplatRadiusMm(const Camera& camera, float view_depth_mm,
+                            float splat_pixels = shader::kCoverageSplatPixels);
 
 // Splats history.previous_keys (seen by history.camera) into `coverage`:
 // a uint per pixel of `frame` (row-major), which the caller cleared to
 // kCoverageFarBits and made visible to compute; frame.camera holds the new
 // camera `camera`, visible to compute. The caller places the barrier after.
-// Both frames are frame.width x frame.height.
+// Both frames are frame.width x frame.height. `splat_pixels`: k of R_S(z).
 void recordCoverageReproject(VkCommandBuffer cmd, const gpu::ComputePipeline& pipeline, const CoverageHistory& history,
-                             const Camera& camera, const GpuFrameTargets& frame, VkDeviceAddress coverage);
+                             const Camera& camera, const GpuFrameTargets& frame, VkDeviceAddress coverage,
+                             float splat_pixels = shader::kCoverageSplatPixels);
 
 }  // namespace fibscope

@@ -279,7 +279,8 @@ void recordCulledRaster(VkCommandBuffer cmd, const gpu::VulkanContext& context, 
     gpu::PassScope pass(cmd, timer, "coverage", gpu::kComputeToCompute);
     vkCmdFillBuffer(cmd, buffers.pyramid.buffer, 0, frame.pixels() * sizeof(float), shader::kCoverageFarBits);
     gpu::recordBarrier(cmd, gpu::kTransferToCompute);
-    recordCoverageReproject(cmd, passes.coverage, buffers.coverage, cull.camera, frame, buffers.pyramid.address);
+    recordCoverageReproject(cmd, passes.coverage, buffers.coverage, cull.camera, frame, buffers.pyramid.address,
+                            cull.coverage_splat_px);
     gpu::computeToComputeBarrier(cmd);
     recordDepthPyramid(cmd, passes, frame, buffers, 1);
   }

@@ -25,6 +25,7 @@
 #include "gpu/vulkan_context.h"
 #include "render/camera.h"
 #include "render/gpu/coverage_pass.h"
+#include "shared/coverage_push.h"
 #include "render/gpu/dataset.h"
 #include "render/gpu/fiblet_passes.h"
 #include "render/gpu/frame_targets.h"
@@ -116,6 +117,7 @@ struct CullFrame {
   // The frame's camera (Coverage re-projects the last frame into it and
   // keeps it for the next).
   Camera camera;
+  float coverage_splat_px = shader::kCoverageSplatPixels;  // Coverage: k of R_S(z)
 };
 
 // |P[1][1]| * height / 2: a length l at view distance z projects to

@@ -94,7 +94,8 @@ class FibletStage final : public FrameStage {
                          settings.culling == CullingMode::Coverage);
       recordCulledRaster(frame.cmd, frame.context, cull_passes_, fiblet_passes_, layout, frame.targets, cull_buffers_,
                          CullFrame{settings.culling, settings.culling == CullingMode::None ? 0.0f : settings.lod_pixels,
-                                   cullFocalPixels(frame.camera), frame.scene.kept_bits, frame.camera},
+                                   cullFocalPixels(frame.camera), frame.scene.kept_bits, frame.camera,
+                                   settings.coverage_splat_px},
                          frame.timer);
     } else {
       gpu::PassScope pass(frame.cmd, frame.timer, "raster", gpu::kComputeToCompute);
