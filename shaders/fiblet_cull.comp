@@ -1,7 +1,9 @@
 // Cull (DESIGN.md section 6, step 1): one invocation per fiblet. The
 // fiblet's bounding sphere is tested against the frustum dilated by the line
 // width (paper eq. 5) and, in phase 2 of two-phase culling, against the
-// max-depth pyramid of what phase 1 drew; fiblets smaller on screen than
+// max-depth pyramid of what phase 1 drew (in coverage mode, against the
+// pyramid of the previous frame re-projected: coverage_reproject.comp, the
+// same test, one pass); fiblets smaller on screen than
 // lod_pixels go to the LoD list (drawn as one segment), the others to the
 // full list. Modes and the argument for conservativeness: shared/cull_push.h.
 //
@@ -268,7 +270,9 @@ void main() {
       target = 0;
     } else if (sphereInFrustum(cam, c, r)) {
       bool draw = true;
-      if (pc.mode != kCullFrustum) {
+      if (pc.mode == kCullCoverage) {
+        draw = !sphereOccluded(cam, c, r);
+      } else if (pc.mode != kCullFrustum) {
         const bool was_visible = (bits.words[fiblet >> 5u] & (1u << (fiblet & 31u))) != 0u;
         if (pc.mode == kCullPhase1) {
           draw = was_visible;

@@ -27,9 +27,7 @@
 
 SHADER_NAMESPACE_BEGIN
 
-// FibletCullPush::mode. A second occlusion mode (the paper's re-projected
-// coverage buffer, section 3.4.1) would be one more value testing a
-// different buffer in place of the pyramid.
+// FibletCullPush::mode.
 CULL_CONST uint kCullFrustum = 0u;  // dilated frustum + LoD, no occlusion (CullingMode::Frustum)
 CULL_CONST uint kCullPhase1 = 1u;   // ... restricted to fiblets whose visible bit is set
 CULL_CONST uint kCullPhase2 = 2u;   // ... + pyramid test, rewrites the visible bits, skips phase-1 fiblets
@@ -37,6 +35,11 @@ CULL_CONST uint kCullPhase2 = 2u;   // ... + pyramid test, rewrites the visible 
 // (CullingMode::None while a fiber filter is on). Every mode skips the
 // fiblets of fibers the filter dropped (FibletCullPush::kept).
 CULL_CONST uint kCullKeptOnly = 3u;
+// The paper's coverage buffer (CullingMode::Coverage, shared/coverage_push.h):
+// Frustum + the pyramid test against the re-projected previous frame, in
+// one pass: no visible bits, and NOT conservative (a fiblet the last frame
+// hid and this one uncovers may be culled).
+CULL_CONST uint kCullCoverage = 4u;
 
 // The largest pyramid: 16384 px per side (createFrameTargets' limit) has 15
 // levels.
@@ -79,7 +82,7 @@ struct FibletCullPush {
   // word offset, a whole number of kCullGroupSize groups), so a workgroup
   // still owns its two words when several datasets share the buffer.
   uint64_t visible;
-  uint64_t pyramid;   // float, every level of the max-depth pyramid (kCullPhase2)
+  uint64_t pyramid;   // float, every level of the max-depth pyramid (kCullPhase2, kCullCoverage)
   // The fiber filter's kept bits over the scene's fibers
   // (select/gpu/gpu_fiber_filter.h), or 0: every fiber kept. The dataset's
   // fiber f is the scene's fiber_base + f.

@@ -1,11 +1,15 @@
 // `fibscope bench [FILE] [--pipeline P] [--culling C] [--compare P[/C],...]
-// [--frames N] [--step DEG] [--size WxH] [--json]`: the fiblets paper's
+// [--frames N] [--step DEG] [--size WxH] [--count-missed] [--json]`: the fiblets paper's
 // frame benchmark (section 5): 1920x1080, the camera orbiting the
 // tractogram at 1.14 degrees per frame for a full turn (316 frames), GPU
 // timestamps around every pass. Prints mean / median / p95 frame time, the
 // time of each pass, the fraction of fiblets drawn and segments drawn per
 // millisecond; with --compare, several pipelines draw the same frames in one
 // run (frame by frame, in turn) and their ratios to the first are printed.
+// --count-missed also draws every measured frame with culling off (untimed)
+// and counts, per occlusion-culled compute variant, the pixels covered
+// there but not in its frame: zero for two-phase, the artifact of the
+// coverage buffer (CullingMode::Coverage, paper figure 9).
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
@@ -13,6 +17,7 @@
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <numeric>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -44,6 +49,7 @@ struct BenchOptions {
   // the previous frame the full orbit would have shown it; the fractions
   // drawn estimate the full orbit's at 2N / frames of its cost.
   uint32_t sample = 0;
+  bool count_missed = false;
   bool json = false;
 };
 
@@ -76,7 +82,21 @@ struct Variant {
   std::map<std::string, double> pass_ms_sum;
   std::vector<std::string> pass_order;
   uint64_t segments_drawn_sum = 0;
+  std::vector<uint64_t> missed_pixels;   // --count-missed: per measured frame
+  std::vector<uint64_t> changed_pixels;  // ... and keys that differ at all (another fiber shows)
 };
+
+// Pixels the reference keys cover that `keys` leave empty, and pixels whose
+// keys differ at all.
+void countMissed(const std::vector<uint64_t>& reference, const std::vector<uint64_t>& keys, Variant& v) {
+  uint64_t missed = 0, changed = 0;
+  for (size_t i = 0; i < reference.size() && i < keys.size(); ++i) {
+    missed += reference[i] != ~uint64_t(0) && keys[i] == ~uint64_t(0);
+    changed += reference[i] != keys[i];
+  }
+  v.missed_pixels.push_back(missed);
+  v.changed_pixels.push_back(changed);
+}
 
 std::vector<Variant> variantsFrom(const BenchOptions& o) {
   const RenderSettings base = renderSettingsFrom(o.render);
@@ -159,6 +179,26 @@ void runBench(const BenchOptions& o) {
   // visibility, which must be its own.
   std::vector<std::unique_ptr<FrameRenderer>> renderers;
   for (size_t i = 0; i < variants.size(); ++i) renderers.push_back(std::make_unique<FrameRenderer>(*context, width, height));
+  // --count-missed: the unculled frame each culled compute variant is
+  // compared with (the first compute variant's settings, culling off).
+  // With LoD on, frustum culling with the same LoD instead: culling off
+  // has no LoD, and the LoD's segments would count as misses. Frustum
+  // culling keeps every fiblet in view, so it draws culling off's frame
+  // (bit for bit without LoD: gpu_culling_test.cpp) with the variants' LoD.
+  std::unique_ptr<FrameRenderer> reference;
+  RenderSettings reference_settings;
+  GpuScene reference_scene = gpu_scene;
+  if (o.count_missed) {
+    const auto compute = std::find_if(variants.begin(), variants.end(), [](const Variant& v) {
+      return v.settings.pipeline == RenderPipeline::Compute;
+    });
+    if (compute == variants.end()) throw Error("--count-missed: no compute variant to count missed pixels of");
+    reference_settings = compute->settings;
+    reference_settings.culling = reference_settings.lod_pixels > 0 ? CullingMode::Frustum : CullingMode::None;
+    filter.apply(reference_scene, RenderPipeline::Compute);
+    reference = std::make_unique<FrameRenderer>(*context, width, height);
+  }
+  uint64_t reference_covered = 0;
 
   nlohmann::json out;
   // A constant distance for the whole orbit: the farthest of the snug fits
@@ -204,8 +244,27 @@ void runBench(const BenchOptions& o) {
         v.pass_ms_sum[p.name] += p.ms;
       }
     }
+    // The reference after the variants: an occlusion variant's first frame
+    // computes the datasets' exact fiblet spheres, which the frustum test
+    // and LoD then use too (dataset.h); drawn before, the reference's
+    // first frame would choose its LoD on the looser record bounds.
+    if (reference && frame.measured) {
+      reference->render(camera, reference_settings, reference_scene);
+      const std::vector<uint64_t> reference_keys = downloadVisibility(*context, reference->targets());
+      for (uint64_t key : reference_keys) reference_covered += key != ~uint64_t(0);
+      for (size_t i = 0; i < variants.size(); ++i) {
+        const RenderSettings& s = variants[i].settings;
+        if (s.pipeline == RenderPipeline::Compute &&
+            (s.culling == CullingMode::TwoPhase || s.culling == CullingMode::Coverage))
+          countMissed(reference_keys, downloadVisibility(*context, renderers[i]->targets()), variants[i]);
+      }
+    }
   }
   checkValidation(*context, o.render);
+  if (o.count_missed) {
+    out["reference_covered_pixels"] = reference_covered;  // summed over the measured frames
+    out["missed_reference"] = "compute/" + std::string(cullingModeName(reference_settings.culling));
+  }
 
   out["input"] = scene.name;
   out["device"] = context->info().name;
@@ -264,6 +323,20 @@ void runBench(const BenchOptions& o) {
     j["wall_median_ms"] = percentile(v.wall_ms, 50);
     j["median_ratio_to_first"] = base_median > 0 ? ratioTime(v) / base_median : 0.0;
     for (const std::string& name : v.pass_order) j["pass_mean_ms"][name] = v.pass_ms_sum[name] / double(measured);
+    uint64_t missed_total = 0, missed_max = 0;
+    for (uint64_t m : v.missed_pixels) {
+      missed_total += m;
+      missed_max = std::max(missed_max, m);
+    }
+    if (!v.missed_pixels.empty()) {
+      j["missed_pixels"] = v.missed_pixels;
+      j["missed_pixels_total"] = missed_total;
+      j["missed_pixels_max"] = missed_max;
+      uint64_t changed_total = 0;
+      for (uint64_t c : v.changed_pixels) changed_total += c;
+      j["changed_pixels"] = v.changed_pixels;
+      j["changed_pixels_total"] = changed_total;
+    }
     if (!o.json) {
       std::printf("%-20s %10.3f %10.3f %10.3f %10.3f", v.label.c_str(), mean(v.gpu_ms), median,
                   percentile(v.gpu_ms, 95), mean(v.wall_ms));
@@ -275,6 +348,14 @@ void runBench(const BenchOptions& o) {
       std::printf("\n    passes:");
       for (const std::string& name : v.pass_order) std::printf(" %s %.3f", name.c_str(), v.pass_ms_sum[name] / double(measured));
       std::printf(" (mean ms)\n");
+      if (!v.missed_pixels.empty())
+        std::printf("    missed pixels (covered by compute/%s, not here): %llu in %zu frames, at most %llu in one; "
+                    "%llu pixels changed\n",
+                    std::string(cullingModeName(reference_settings.culling)).c_str(),
+                    static_cast<unsigned long long>(missed_total), v.missed_pixels.size(),
+                    static_cast<unsigned long long>(missed_max),
+                    static_cast<unsigned long long>(
+                        std::accumulate(v.changed_pixels.begin(), v.changed_pixels.end(), uint64_t(0))));
     }
     out["results"].push_back(j);
   }
@@ -288,8 +369,8 @@ void addBenchCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("bench", "Frame benchmark: the camera orbits the tractogram (fiblets paper protocol)");
   addRenderCliOptions(cmd, o->render);
   cmd->add_option("--compare", o->compare,
-                  "Pipelines drawn on the same frames, e.g. compute/two-phase,compute/none,lines,raw-compute,geometry/frustum,"
-                  "tessellation/none; ratios are to the first");
+                  "Pipelines drawn on the same frames, e.g. compute/two-phase,compute/coverage,compute/none,lines,"
+                  "raw-compute,geometry/frustum,tessellation/none; ratios are to the first");
   cmd->add_option("--frames", o->frames, "Measured frames")->capture_default_str();
   cmd->add_option("--step", o->step_deg, "Orbit step per frame, degrees")->capture_default_str();
   cmd->add_option("--elevation", o->elevation_deg, "Orbit elevation, degrees")->capture_default_str();
@@ -299,6 +380,10 @@ void addBenchCommand(CLI::App& app) {
                   "Measure N frames spread evenly over the orbit, each after the frame one step before it "
                   "(0: every frame)")
       ->capture_default_str();
+  cmd->add_flag("--count-missed", o->count_missed,
+                "Also draw each measured frame with culling off (frustum culling with the same LoD when LoD is on; "
+                "untimed) and count the pixels each occlusion-culled compute variant misses (JSON: missed_pixels "
+                "per frame, missed_pixels_total)");
   cmd->add_flag("--json", o->json, "Print the results as JSON");
   cmd->callback([o] { runBench(*o); });
 }

@@ -29,7 +29,8 @@ constexpr std::pair<std::string_view, RenderPipeline> kPipelines[] = {
     {"raw-compute", RenderPipeline::RawCompute}, {"geometry", RenderPipeline::Geometry},
     {"tessellation", RenderPipeline::Tessellation}};
 constexpr std::pair<std::string_view, CullingMode> kCulling[] = {
-    {"none", CullingMode::None}, {"frustum", CullingMode::Frustum}, {"two-phase", CullingMode::TwoPhase}};
+    {"none", CullingMode::None}, {"frustum", CullingMode::Frustum}, {"two-phase", CullingMode::TwoPhase},
+    {"coverage", CullingMode::Coverage}};
 constexpr std::pair<std::string_view, ColorMode> kColors[] = {
     {"solid", ColorMode::Solid}, {"orientation", ColorMode::Orientation}, {"fiber", ColorMode::PerFiber},
     {"scalar", ColorMode::Scalar}, {"normal", ColorMode::Normal}};

@@ -38,6 +38,9 @@ enum class CullingMode : uint8_t {
   None,      // every fiblet is drawn, no LoD
   Frustum,   // dilated frustum (paper eq. 5) and far-view LoD
   TwoPhase,  // Frustum + conservative two-phase occlusion culling
+  // Frustum + the paper's coverage buffer (the previous frame's depth
+  // re-projected; one pass, NOT conservative: shaders/shared/coverage_push.h)
+  Coverage,
 };
 
 enum class ColorMode : uint8_t {
@@ -82,7 +85,11 @@ enum class Lighting : uint8_t {
 struct RenderSettings {
   RenderPipeline pipeline = RenderPipeline::Compute;
   CullingMode culling = CullingMode::TwoPhase;
-  float lod_pixels = 4.0f;  // far-view LoD below this projected fiblet size (Frustum, TwoPhase)
+  float lod_pixels = 4.0f;  // far-view LoD below this projected fiblet size (Frustum, TwoPhase, Coverage)
+  // Coverage: the splat radius R_S(z) in previous-frame pixels
+  // (shared/coverage_push.h; the default, half a pixel's diagonal, gives
+  // the unculled frame with the camera still, larger culls more and misses more).
+  float coverage_splat_px = 0.70710678f;
   float line_width_px = 1.0f;  // [1, 4]
   ColorMode color = ColorMode::Orientation;
   std::array<float, 3> solid_color = {0.9f, 0.9f, 0.85f};

@@ -82,6 +82,7 @@ bool isFiblets(const RenderSettings& s) { return drawsFiblets(s.pipeline); }
 // The far-view LoD is the compute pipeline's (the graphics fiblet pipelines
 // draw every culled-in fiblet at full detail).
 bool isCulled(const RenderSettings& s) { return s.pipeline == RenderPipeline::Compute && s.culling != CullingMode::None; }
+bool isCoverage(const RenderSettings& s) { return s.pipeline == RenderPipeline::Compute && s.culling == CullingMode::Coverage; }
 bool isSolid(const RenderSettings& s) { return s.color == ColorMode::Solid; }
 bool isScalar(const RenderSettings& s) { return s.color == ColorMode::Scalar; }
 bool isLit(const RenderSettings& s) { return s.lighting == Lighting::IlluminatedLines; }
@@ -95,16 +96,24 @@ std::vector<SettingInfo> makeTable() {
                      [](int v) { return renderPipelineName(RenderPipeline(v)); },
                      getChoice<RenderPipeline, &RenderSettings::pipeline>,
                      setChoice<RenderPipeline, &RenderSettings::pipeline>));
-  t.push_back(with(choice("culling", "culling", "none | frustum | two-phase (fiblet pipelines: compute, geometry, tessellation)", 3,
+  t.push_back(with(choice("culling", "culling",
+                          "none | frustum | two-phase (fiblet pipelines: compute, geometry, tessellation) | coverage "
+                          "(compute pipeline)",
+                          4,
                           [](int v) { return cullingModeName(CullingMode(v)); },
                           getChoice<CullingMode, &RenderSettings::culling>,
                           setChoice<CullingMode, &RenderSettings::culling>),
                    isFiblets));
   t.push_back(with(number("lod-pixels", "LoD below",
                           "Far-view LoD: fiblets whose bounding sphere projects smaller are drawn as one segment "
-                          "(frustum and two-phase culling; 0: off)",
+                          "(frustum, two-phase and coverage culling; 0: off)",
                           &RenderSettings::lod_pixels, 0, 4096, "px"),
                    isCulled));
+  t.push_back(with(number("coverage-splat", "coverage splat",
+                          "Coverage culling: the radius of each re-projected sample's hemisphere in previous-frame "
+                          "pixels (0.71: exact with the camera still; larger culls more and misses more)",
+                          &RenderSettings::coverage_splat_px, 0.5f, 8, "px"),
+                   isCoverage));
   SettingInfo width = number("line-width", "line width", "Line width in pixels", &RenderSettings::line_width_px,
                              kMinLineWidth, kMaxLineWidth, "px");
   width.alias = "width";

@@ -65,7 +65,7 @@ const SettingInfo* findSetting(std::string_view name);
 void setSetting(RenderSettings& settings, const SettingInfo& info, std::string_view text, std::string_view where);
 // The member as such text ("on", "12.5", "two-phase", "0.1,0.2,0.3").
 std::string settingText(const RenderSettings& settings, const SettingInfo& info);
-// "1 to 64 px", "on or off", "one of: none, frustum, two-phase", ...
+// "1 to 64 px", "on or off", "one of: none, frustum, two-phase, coverage", ...
 std::string settingExpectation(const SettingInfo& info);
 
 // Every entry's member within its range (a choice within its names, a

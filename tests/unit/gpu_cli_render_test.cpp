@@ -269,5 +269,27 @@ TEST_F(GpuCliRender, benchSampleDrawsWhatTheFullOrbitDrawsOnTheSameFrames) {
   EXPECT_EQ(lineCount(bad.output), 1) << bad.output;
 }
 
+TEST_F(GpuCliRender, benchCountsMissedPixelsAgainstCullingOff) {
+  const auto r = runGpuFibscope(
+      "bench --validate --json --phantom-streamlines 200 --size 160x120 --frames 3 --warmup 0 --step 60 "
+      "--count-missed --compare compute/two-phase,compute/coverage,compute/none");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto json = nlohmann::json::parse(r.output.substr(r.output.find('{')));
+  EXPECT_GT(json["reference_covered_pixels"].get<uint64_t>(), 0u);
+  ASSERT_EQ(json["results"].size(), 3u);
+  for (const auto& result : json["results"]) {
+    if (result["pipeline"] == "compute/none") {
+      EXPECT_FALSE(result.contains("missed_pixels")) << "culling off is the reference";
+      continue;
+    }
+    ASSERT_EQ(result["missed_pixels"].size(), 3u) << result.dump();
+    uint64_t sum = 0;
+    for (const auto& m : result["missed_pixels"]) sum += m.get<uint64_t>();
+    EXPECT_EQ(result["missed_pixels_total"].get<uint64_t>(), sum);
+    if (result["pipeline"] == "compute/two-phase") EXPECT_EQ(sum, 0u) << "two-phase is conservative";
+    EXPECT_EQ(result["missed_pixels"][0].get<uint64_t>(), 0u) << "the first frame has no history to miss by";
+  }
+}
+
 }  // namespace
 }  // namespace fibscope

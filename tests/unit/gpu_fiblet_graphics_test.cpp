@@ -31,6 +31,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -431,6 +432,13 @@ TEST_F(GpuCliFibletGraphics, renderDrawsEachPipelineToAPngAndRefusesBadNamesInOn
   EXPECT_EQ(bad.exit_code, 2) << bad.output;
   EXPECT_EQ(lineCount(bad.output), 1) << bad.output;
   EXPECT_NE(bad.output.find("tessellation"), std::string::npos) << "the accepted names: " << bad.output;
+  // Coverage culling re-projects the compute pipeline's keys: refused here.
+  const auto coverage = test::runCommand(std::string(FIBSCOPE_EXE) +
+                                         " render --phantom-streamlines 100 --size 64x48 --pipeline geometry "
+                                         "--culling coverage -o " + dir_.file("coverage.png"));
+  EXPECT_EQ(coverage.exit_code, 2) << coverage.output;
+  EXPECT_EQ(lineCount(coverage.output), 1) << coverage.output;
+  EXPECT_FALSE(std::filesystem::exists(dir_.file("coverage.png")));
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include "core/error.h"
 #include "gpu/pass_scope.h"
 #include "gpu/submit.h"
+#include "shared/coverage_push.h"
 #include "shared/cull_push.h"
 #include "shared/fiblet_list.h"
 #include "shared/render_config.h"
@@ -137,6 +138,7 @@ CullPasses createCullPasses(const gpu::VulkanContext& context) {
     passes.lod_raster =
         gpu::createComputePipeline(context, "fiblet_lod_raster.comp", sizeof(shader::FibletLodRasterPush),
                                    gpu::WorkgroupSize{shader::kLodRasterGroupSize});
+    passes.coverage = createCoveragePipeline(context);
   } catch (...) {
     destroyCullPasses(context, passes);
     throw;
@@ -145,6 +147,7 @@ CullPasses createCullPasses(const gpu::VulkanContext& context) {
 }
 
 void destroyCullPasses(const gpu::VulkanContext& context, CullPasses& passes) {
+  gpu::destroyComputePipeline(context, passes.coverage);
   gpu::destroyComputePipeline(context, passes.lod_raster);
   gpu::destroyComputePipeline(context, passes.pyramid);
   gpu::destroyComputePipeline(context, passes.finalize);
@@ -152,7 +155,8 @@ void destroyCullPasses(const gpu::VulkanContext& context, CullPasses& passes) {
 }
 
 void prepareCullBuffers(const gpu::VulkanContext& context, CullBuffers& buffers,
-                        std::span<const uint32_t> dataset_fiblets, uint32_t width, uint32_t height) {
+                        std::span<const uint32_t> dataset_fiblets, uint32_t width, uint32_t height,
+                        bool coverage) {
   if (dataset_fiblets.size() > shader::kMaxSceneDatasets)
     throw Error("cull: at most " + std::to_string(shader::kMaxSceneDatasets) + " datasets per frame, got " +
                 std::to_string(dataset_fiblets.size()));
@@ -197,12 +201,14 @@ void prepareCullBuffers(const gpu::VulkanContext& context, CullBuffers& buffers,
       gpu::destroyBuffer(context, buffers.pyramid);
       buffers.width = buffers.height = 0;
       buffers.history_valid = false;
+      buffers.coverage.valid = false;
       const uint32_t levels = shader::pyramidLevelCount(width, height);
       const uint64_t texels = shader::pyramidLevelOffset(width, height, levels);
       buffers.pyramid = gpu::createBuffer(context, texels * sizeof(float), gpu::MemoryUse::DeviceLocal);
       buffers.width = width;
       buffers.height = height;
     }
+    if (coverage) prepareCoverageHistory(context, buffers.coverage, width, height);
   } catch (...) {
     destroyCullBuffers(context, buffers);
     throw;
@@ -210,12 +216,13 @@ void prepareCullBuffers(const gpu::VulkanContext& context, CullBuffers& buffers,
 }
 
 void prepareCullBuffers(const gpu::VulkanContext& context, CullBuffers& buffers, uint32_t fiblets, uint32_t width,
-                        uint32_t height) {
+                        uint32_t height, bool coverage) {
   const uint32_t one[] = {fiblets};
-  prepareCullBuffers(context, buffers, one, width, height);
+  prepareCullBuffers(context, buffers, one, width, height, coverage);
 }
 
 void destroyCullBuffers(const gpu::VulkanContext& context, CullBuffers& buffers) {
+  destroyCoverageHistory(context, buffers.coverage);
   gpu::destroyBuffer(context, buffers.stats);
   gpu::destroyBuffer(context, buffers.pyramid);
   gpu::destroyBuffer(context, buffers.visible);
@@ -225,7 +232,7 @@ void destroyCullBuffers(const gpu::VulkanContext& context, CullBuffers& buffers)
 }
 
 void recordDepthPyramid(VkCommandBuffer cmd, const CullPasses& passes, const GpuFrameTargets& frame,
-                        const CullBuffers& buffers, bool from_gbuffer) {
+                        const CullBuffers& buffers, uint32_t first_level, bool from_gbuffer) {
   shader::DepthPyramidPush push{};
   push.visibility = frame.visibility.address;
   push.gbuffer = from_gbuffer ? frame.gbuffer.address : 0;
@@ -233,8 +240,8 @@ void recordDepthPyramid(VkCommandBuffer cmd, const CullPasses& passes, const Gpu
   push.width = frame.width;
   push.height = frame.height;
   const uint32_t levels = shader::pyramidLevelCount(frame.width, frame.height);
-  for (uint32_t level = 0; level < levels; ++level) {
-    if (level > 0) gpu::computeToComputeBarrier(cmd);
+  for (uint32_t level = first_level; level < levels; ++level) {
+    if (level > first_level) gpu::computeToComputeBarrier(cmd);
     push.level = level;
     const uint32_t w = shader::pyramidLevelSize(frame.width, level);
     const uint32_t h = shader::pyramidLevelSize(frame.height, level);
@@ -254,15 +261,35 @@ void recordCulledRaster(VkCommandBuffer cmd, const gpu::VulkanContext& context, 
     throw Error("cull: the buffers were prepared for " + std::to_string(buffers.regions.size()) + " datasets, the scene has " +
                 std::to_string(scene.entries.size()));
   const bool two_phase = cull.mode == CullingMode::TwoPhase;
+  const bool coverage = cull.mode == CullingMode::Coverage;
   const bool reset_history = two_phase && (!buffers.history_valid || !sameScene(buffers.history_scene, scene));
+  if (coverage && !buffers.coverage.previous_keys.buffer)
+    throw Error("cull: coverage culling needs buffers prepared for it");
+  // The last Coverage frame can be re-projected: same scene and size.
+  const bool reproject = coverage && buffers.coverage.valid && sameScene(buffers.coverage.scene, scene) &&
+                         buffers.coverage.camera.width == frame.width &&
+                         buffers.coverage.camera.height == frame.height;
   // Uses of the lists and bits by earlier work before the resets below.
   computeToTransfer(cmd);
   vkCmdFillBuffer(cmd, buffers.stats.buffer, 0, VK_WHOLE_SIZE, 0);
   if (reset_history) vkCmdFillBuffer(cmd, buffers.visible.buffer, 0, VK_WHOLE_SIZE, 0xFFFFFFFFu);
 
+  if (reproject) {
+    // The coverage buffer is the pyramid's level 0 (float bits, far = 1.0
+    // where no splat lands), then its max-mip levels.
+    gpu::PassScope pass(cmd, timer, "coverage", gpu::kComputeToCompute);
+    vkCmdFillBuffer(cmd, buffers.pyramid.buffer, 0, frame.pixels() * sizeof(float), shader::kCoverageFarBits);
+    gpu::recordBarrier(cmd, gpu::kTransferToCompute);
+    recordCoverageReproject(cmd, passes.coverage, buffers.coverage, cull.camera, frame, buffers.pyramid.address,
+                            cull.coverage_splat_px);
+    gpu::computeToComputeBarrier(cmd);
+    recordDepthPyramid(cmd, passes, frame, buffers, 1);
+  }
+
   const uint32_t first_mode = two_phase                           ? shader::kCullPhase1
-                              : cull.mode == CullingMode::Frustum ? shader::kCullFrustum
-                                                                  : shader::kCullKeptOnly;
+                              : reproject                         ? shader::kCullCoverage
+                              : cull.mode == CullingMode::None    ? shader::kCullKeptOnly
+                                                                  : shader::kCullFrustum;
   recordPhase(cmd, context, passes, fiblet_passes, scene, frame, buffers, first_mode, cull, timer,
               two_phase ? "cull 1" : "cull", two_phase ? "raster 1" : "raster");
   if (two_phase) {
@@ -281,6 +308,19 @@ void recordCulledRaster(VkCommandBuffer cmd, const gpu::VulkanContext& context, 
   }
   computeToTransfer(cmd);
   copyCounts(cmd, buffers, two_phase ? 1 : 0);
+  if (coverage) {
+    // The raster's keys (visible to transfers: the barrier above) for the
+    // next frame's re-projection; its compute reads after this copy.
+    const VkBufferCopy region{0, 0, buffers.coverage.previous_keys.size};
+    vkCmdCopyBuffer(cmd, frame.visibility.buffer, buffers.coverage.previous_keys.buffer, 1, &region);
+    gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT,
+                       VK_ACCESS_2_TRANSFER_WRITE_BIT | VK_ACCESS_2_TRANSFER_READ_BIT,
+                       VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_TRANSFER_BIT,
+                       gpu::kStorageReadWrite | VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    buffers.coverage.camera = cull.camera;
+    buffers.coverage.scene = scene;
+  }
+  buffers.coverage.valid = coverage;
   gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                      VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
   buffers.history_valid = two_phase;

@@ -1,9 +1,11 @@
 // The cull passes of the compute pipeline (DESIGN.md section 6, step 1):
 // the dilated-frustum test and far-view LoD (CullingMode::Frustum), and the
-// conservative two-phase occlusion culling (CullingMode::TwoPhase). Shaders:
+// conservative two-phase occlusion culling (CullingMode::TwoPhase), and the
+// paper's coverage buffer (CullingMode::Coverage, coverage_pass.h). Shaders:
 // fiblet_cull.comp, fiblet_list_finalize.comp, depth_pyramid.comp,
-// fiblet_lod_raster.comp; the arithmetic and the argument that no visible
-// fiblet is culled are in shaders/shared/cull_push.h.
+// fiblet_lod_raster.comp, coverage_reproject.comp; the arithmetic and the
+// argument that two-phase culls no visible fiblet are in
+// shaders/shared/cull_push.h (coverage's, which may: shared/coverage_push.h).
 //
 // Unlike the other pass files this one also records the whole culled raster
 // (recordCulledRaster): its passes need a dozen barriers of their own
@@ -22,6 +24,8 @@
 #include "gpu/gpu_timer.h"
 #include "gpu/vulkan_context.h"
 #include "render/camera.h"
+#include "render/gpu/coverage_pass.h"
+#include "shared/coverage_push.h"
 #include "render/gpu/dataset.h"
 #include "render/gpu/fiblet_passes.h"
 #include "render/gpu/frame_targets.h"
@@ -35,6 +39,7 @@ struct CullPasses {
   gpu::ComputePipeline finalize;    // fiblet_list_finalize.comp
   gpu::ComputePipeline pyramid;     // depth_pyramid.comp
   gpu::ComputePipeline lod_raster;  // fiblet_lod_raster.comp
+  gpu::ComputePipeline coverage;    // coverage_reproject.comp
 };
 
 CullPasses createCullPasses(const gpu::VulkanContext& context);
@@ -74,37 +79,47 @@ struct CullBuffers {
   // first.
   bool history_valid = false;
   SceneLayout history_scene;
+  // CullingMode::Coverage: the last Coverage frame's keys and camera
+  // (sized with the pyramid; a new size drops it).
+  CoverageHistory coverage;
 };
 
 // Makes the buffers fit datasets of `dataset_fiblets` fiblets (one region
 // each, in order; at most kMaxSceneDatasets) and a width x height frame,
 // reallocating what is too small (lists, bits) or of another size
 // (pyramid); either invalidates the history. Throws Error when memory runs
-// out (the buffers are then released).
+// out (the buffers are then released). `coverage`: also the coverage
+// history's keys (only Coverage frames need them).
 void prepareCullBuffers(const gpu::VulkanContext& context, CullBuffers& buffers,
-                        std::span<const uint32_t> dataset_fiblets, uint32_t width, uint32_t height);
+                        std::span<const uint32_t> dataset_fiblets, uint32_t width, uint32_t height,
+                        bool coverage = false);
 // One dataset.
 void prepareCullBuffers(const gpu::VulkanContext& context, CullBuffers& buffers, uint32_t fiblets, uint32_t width,
-                        uint32_t height);
+                        uint32_t height, bool coverage = false);
 void destroyCullBuffers(const gpu::VulkanContext& context, CullBuffers& buffers);
 
 // The max-depth pyramid of frame.visibility into buffers.pyramid (which
 // prepareCullBuffers sized for the frame): every level, one dispatch each,
 // with a barrier between levels; the caller makes the visibility writes
-// visible before and places the barrier after.
-// With `from_gbuffer`, level 0 is frame.gbuffer's depths instead (the
-// graphics fiblet pipelines).
+// visible before and places the barrier after. first_level 1: level 0 is
+// already there (Coverage writes it), the levels above are built from it.
+// With `from_gbuffer`, level 0 is frame.gbuffer's depths instead of the
+// visibility buffer's (the graphics fiblet pipelines).
 void recordDepthPyramid(VkCommandBuffer cmd, const CullPasses& passes, const GpuFrameTargets& frame,
-                        const CullBuffers& buffers, bool from_gbuffer = false);
+                        const CullBuffers& buffers, uint32_t first_level = 0, bool from_gbuffer = false);
 
 // What recordCulledRaster needs besides the buffers.
 struct CullFrame {
-  // Frustum or TwoPhase; None: no test but the fiber filter's (every
-  // fiblet of a kept fiber drawn at full detail).
+  // Frustum, TwoPhase or Coverage; None: no test but the fiber filter's
+  // (every fiblet of a kept fiber drawn at full detail).
   CullingMode mode = CullingMode::Frustum;
   float lod_pixels = 0;                     // 0: no LoD
   float focal_px = 0;                       // cullFocalPixels(camera)
   VkDeviceAddress kept_bits = 0;            // GpuScene::kept_bits: the filter's fibers only; 0: all
+  // The frame's camera (Coverage re-projects the last frame into it and
+  // keeps it for the next).
+  Camera camera;
+  float coverage_splat_px = shader::kCoverageSplatPixels;  // Coverage: k of R_S(z)
 };
 
 // |P[1][1]| * height / 2: a length l at view distance z projects to
@@ -128,6 +143,11 @@ float cullFocalPixels(const Camera& camera);
 //   Frustum:  cull -> finalize -> raster + LoD raster.
 //   TwoPhase: phase-1 cull -> finalize -> raster + LoD raster -> depth
 //             pyramid -> phase-2 cull -> finalize -> raster + LoD raster.
+//   Coverage: coverage (the last Coverage frame's keys re-projected into
+//             the pyramid's level 0, then its other levels) -> cull ->
+//             finalize -> raster + LoD raster -> the keys kept. Without a
+//             valid history (first frame, new size or scene, a frame of
+//             another mode in between) the cull is Frustum's.
 void recordCulledRaster(VkCommandBuffer cmd, const gpu::VulkanContext& context, const CullPasses& passes,
                         const FibletPasses& fiblet_passes, const SceneLayout& scene, const GpuFrameTargets& frame,
                         CullBuffers& buffers, const CullFrame& cull, gpu::GpuTimer* timer);

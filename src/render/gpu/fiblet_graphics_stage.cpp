@@ -43,6 +43,10 @@ class FibletGraphicsStage final : public FrameStage {
   void check(const FrameContext& frame) const override {
     if (frame.scene.datasets.empty())
       throw Error("render: the " + std::string(renderPipelineName(kind_)) + " pipeline needs fiblets");
+    // The coverage buffer re-projects the compute pipeline's visibility keys.
+    if (frame.settings.culling == CullingMode::Coverage)
+      throw Error("render: coverage culling is the compute pipeline's; the " +
+                  std::string(renderPipelineName(kind_)) + " pipeline takes none, frustum or two-phase");
   }
 
   void record(FrameContext& frame) override {
@@ -72,7 +76,7 @@ class FibletGraphicsStage final : public FrameStage {
       // The max-depth pyramid of what phase 1 drew, from the G-buffer copy
       // (the copy's writes before it: the draw pass's barrier).
       gpu::PassScope pass(frame.cmd, frame.timer, "depth pyramid", gpu::kComputeToCompute);
-      recordDepthPyramid(frame.cmd, cull_passes_, frame.targets, cull_buffers_, true);
+      recordDepthPyramid(frame.cmd, cull_passes_, frame.targets, cull_buffers_, 0, true);
     }
     // Phase 2: the rest against the pyramid, drawn over phase 1.
     cullAndDraw(frame, cull, 2, name + " 2");
