@@ -16,6 +16,12 @@
 namespace fibscope {
 namespace {
 
+void checkRegionsMatch(const SceneLayout& scene, const CullBuffers& buffers) {
+  if (scene.entries.size() != buffers.regions.size())
+    throw Error("cull: the buffers were prepared for " + std::to_string(buffers.regions.size()) +
+                " datasets, the scene has " + std::to_string(scene.entries.size()));
+}
+
 constexpr VkDeviceSize kCountOffset = offsetof(shader::FibletListHeader, count);
 // Earlier compute and indirect uses of the lists before transfers
 // (statistics copies, counter resets) touch them.
@@ -257,9 +263,7 @@ float cullFocalPixels(const Camera& camera) {
 void recordCulledRaster(VkCommandBuffer cmd, const gpu::VulkanContext& context, const CullPasses& passes,
                         const FibletPasses& fiblet_passes, const SceneLayout& scene, const GpuFrameTargets& frame,
                         CullBuffers& buffers, const CullFrame& cull, gpu::GpuTimer* timer) {
-  if (scene.entries.size() != buffers.regions.size())
-    throw Error("cull: the buffers were prepared for " + std::to_string(buffers.regions.size()) + " datasets, the scene has " +
-                std::to_string(scene.entries.size()));
+  checkRegionsMatch(scene, buffers);
   const bool two_phase = cull.mode == CullingMode::TwoPhase;
   const bool coverage = cull.mode == CullingMode::Coverage;
   const bool reset_history = two_phase && (!buffers.history_valid || !sameScene(buffers.history_scene, scene));
@@ -330,9 +334,7 @@ void recordCulledRaster(VkCommandBuffer cmd, const gpu::VulkanContext& context, 
 void recordCullLists(VkCommandBuffer cmd, const gpu::VulkanContext& context, const CullPasses& passes,
                      const SceneLayout& scene, const GpuFrameTargets& frame, CullBuffers& buffers,
                      const CullFrame& cull, uint32_t phase) {
-  if (scene.entries.size() != buffers.regions.size())
-    throw Error("cull: the buffers were prepared for " + std::to_string(buffers.regions.size()) +
-                " datasets, the scene has " + std::to_string(scene.entries.size()));
+  checkRegionsMatch(scene, buffers);
   const bool two_phase = cull.mode == CullingMode::TwoPhase;
   if (cull.lod_pixels != 0.0f || two_phase != (phase != 0))
     throw Error("cull: the list-only cull is without LoD, and in phases 1 and 2 for TwoPhase only");
@@ -362,6 +364,12 @@ void recordCullListStats(VkCommandBuffer cmd, const CullBuffers& buffers, uint32
   copyCounts(cmd, buffers, phase == 2 ? 1 : 0);
   gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                      VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+}
+
+void collectCullStats(const gpu::VulkanContext& context, const CullBuffers& buffers, FrameStats& stats) {
+  const CullStats cull = readCullStats(context, buffers);
+  stats.fiblets_drawn = cull.full();
+  stats.fiblets_lod = cull.lod();
 }
 
 CullStats readCullStats(const gpu::VulkanContext& context, const CullBuffers& buffers) {

@@ -179,5 +179,7 @@ struct CullStats {
   uint64_t lod() const { return phase1_lod + phase2_lod; }
 };
 CullStats readCullStats(const gpu::VulkanContext& context, const CullBuffers& buffers);
+// A culled frame's fiblets_drawn and fiblets_lod from readCullStats.
+void collectCullStats(const gpu::VulkanContext& context, const CullBuffers& buffers, FrameStats& stats);
 
 }  // namespace fibscope

@@ -5,9 +5,11 @@
 // stage) into lists that drive one indirect draw per dataset, or every
 // fiblet drawn directly. No far-view LoD: these pipelines compare decoding
 // every fiblet in a graphics stage, so the cull runs with LoD off.
-// Two-phase occlusion culling is refused in one line: its depth pyramid is
-// built from the compute rasters' visibility buffer, which these pipelines
-// do not write.
+// Two-phase occlusion culling draws last frame's visible fiblets, builds
+// the depth pyramid from the G-buffer copy of that draw (these pipelines
+// write no visibility buffer) and draws the rest that pass it. Coverage
+// culling, which re-projects the compute raster's keys, is refused in one
+// line.
 #include <memory>
 #include <string>
 
@@ -84,9 +86,7 @@ class FibletGraphicsStage final : public FrameStage {
 
   void collect(const gpu::VulkanContext& context, FrameStats& stats) override {
     if (!culled_) return;
-    const CullStats cull = readCullStats(context, cull_buffers_);
-    stats.fiblets_drawn = cull.full();
-    stats.fiblets_lod = cull.lod();
+    collectCullStats(context, cull_buffers_, stats);
   }
 
  private:

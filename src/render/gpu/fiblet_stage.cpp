@@ -111,9 +111,7 @@ class FibletStage final : public FrameStage {
 
   void collect(const gpu::VulkanContext& context, FrameStats& stats) override {
     if (!culled_) return;
-    const CullStats cull = readCullStats(context, cull_buffers_);
-    stats.fiblets_drawn = cull.full();
-    stats.fiblets_lod = cull.lod();
+    collectCullStats(context, cull_buffers_, stats);
   }
 
  private:
