@@ -215,12 +215,15 @@ void runRender(RenderCommandOptions o) {
   } else if (o.tubes.requested()) {
     double tube_ms = 0;
     for (const PassTiming& p : stats.passes)
-      if (p.name == "tube bin" || p.name == "tube raycast") tube_ms += p.ms;
-    std::printf("tubes: %llu fibers, %llu nodes (of %llu points, within %.4f mm), %u segments, radius %.3f mm, ray "
-                "cast by compute in %.1f ms, %llu tiles overflowed\n",
+      if (isTubePass(p.name)) tube_ms += p.ms;
+    std::printf("tubes: %llu fibers, %llu nodes (of %llu points, within %.4f mm), %u segments, radius %.3f mm, "
+                "drawn by %s in %.1f ms",
                 static_cast<unsigned long long>(tube_stats.tubes), static_cast<unsigned long long>(tube_stats.nodes),
                 static_cast<unsigned long long>(tube_stats.input_points), o.tubes.tolerance(), tubes.segment_count,
-                o.tubes.radius_mm, tube_ms, static_cast<unsigned long long>(stats.tube_tiles_overflowed));
+                o.tubes.radius_mm, std::string(tubeMethodName(settings.tube_method)).c_str(), tube_ms);
+    if (settings.tube_method == TubeMethod::Compute)
+      std::printf(", %llu tiles overflowed", static_cast<unsigned long long>(stats.tube_tiles_overflowed));
+    std::printf("\n");
   }
   if (filter.active())
     std::printf("filter: %llu of %llu fibers kept (%s), %.2f ms on the GPU\n",

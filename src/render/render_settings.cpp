@@ -40,6 +40,8 @@ constexpr std::pair<std::string_view, Colormap> kColormaps[] = {{"viridis", Colo
                                                                 {"magma", Colormap::Magma},
                                                                 {"grayscale", Colormap::Grayscale},
                                                                 {"coolwarm", Colormap::CoolWarm}};
+constexpr std::pair<std::string_view, TubeMethod> kTubeMethods[] = {
+    {"compute", TubeMethod::Compute}, {"raycast", TubeMethod::Raycast}, {"tess", TubeMethod::Tessellation}};
 
 constexpr std::pair<std::string_view, SliceSampling> kSamplings[] = {{"trilinear", SliceSampling::Trilinear},
                                                                    {"nearest", SliceSampling::Nearest}};
@@ -61,6 +63,8 @@ CullingMode parseCullingMode(std::string_view name) { return parseName("culling"
 ColorMode parseColorMode(std::string_view name) { return parseName("color", name, kColors); }
 Lighting parseLighting(std::string_view name) { return parseName("lighting", name, kLighting); }
 Colormap parseColormap(std::string_view name) { return parseName("colormap", name, kColormaps); }
+TubeMethod parseTubeMethod(std::string_view name) { return parseName("tube-method", name, kTubeMethods); }
+std::string_view tubeMethodName(TubeMethod method) { return nameOf(method, kTubeMethods); }
 std::string_view sliceSamplingName(SliceSampling sampling) { return nameOf(sampling, kSamplings); }
 std::string_view sliceAxisName(SliceAxis axis) { return nameOf(axis, kSliceAxes); }
 std::string_view renderPipelineName(RenderPipeline pipeline) { return nameOf(pipeline, kPipelines); }

@@ -76,6 +76,13 @@ enum class SliceAxis : uint8_t { I, J, K };
 // mrview shows by default; nearest shows the voxels as they are.
 enum class SliceSampling : uint8_t { Trilinear, Nearest };
 
+// How spline tubes (src/tubes; Salm) are drawn into the surface target.
+enum class TubeMethod : uint8_t {
+  Compute,       // ray casting in compute: sub-segment boxes binned into screen tiles (lavapipe, compute-only GPUs)
+  Raycast,       // ray casting in the fragment shader over one instanced box per sub-segment (seed 3.2)
+  Tessellation,  // adaptively tessellated cylinders (seed 3.1)
+};
+
 enum class Lighting : uint8_t {
   None,
   IlluminatedLines,  // Zoeckler / Stalling / Hege: diffuse and specular from the tangent alone
@@ -183,6 +190,14 @@ struct RenderSettings {
   // image (render/orientation_labels.h). Off here; `render` and `view`
   // turn it on by default.
   bool orientation_labels = false;
+  // Spline tubes (when the scene has a tube model): the method, and the
+  // tessellation's base mesh (the seed's 16 rings of 8 vertices, refined by
+  // the tessellator) and multisampling (1: none; 4, 8: the seed's figures
+  // 23-24).
+  TubeMethod tube_method = TubeMethod::Compute;
+  int tube_rings = 16;
+  int tube_vertices = 8;
+  int tube_msaa = 1;
 };
 
 // The slice position by axis (0 = i, 1 = j, 2 = k).
@@ -196,11 +211,13 @@ CullingMode parseCullingMode(std::string_view name);
 ColorMode parseColorMode(std::string_view name);
 Lighting parseLighting(std::string_view name);
 Colormap parseColormap(std::string_view name);
+TubeMethod parseTubeMethod(std::string_view name);
 std::string_view renderPipelineName(RenderPipeline pipeline);
 std::string_view cullingModeName(CullingMode mode);
 std::string_view colorModeName(ColorMode mode);
 std::string_view lightingName(Lighting lighting);
 std::string_view colormapName(Colormap colormap);
+std::string_view tubeMethodName(TubeMethod method);  // "compute", "raycast", "tess"
 std::string_view sliceSamplingName(SliceSampling sampling);
 std::string_view sliceAxisName(SliceAxis axis);
 

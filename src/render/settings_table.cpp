@@ -53,6 +53,15 @@ SettingInfo number(std::string_view name, std::string_view label, std::string_vi
   return i;
 }
 
+SettingInfo integer(std::string_view name, std::string_view label, std::string_view help, int RenderSettings::*m,
+                    double lo, double hi) {
+  SettingInfo i = entry(name, label, help, SettingKind::Integer);
+  i.integer = m;
+  i.min = lo;
+  i.max = hi;
+  return i;
+}
+
 SettingInfo flag(std::string_view name, std::string_view label, std::string_view help, bool RenderSettings::*m) {
   SettingInfo i = entry(name, label, help, SettingKind::Flag);
   i.flag = m;
@@ -89,6 +98,7 @@ bool isLit(const RenderSettings& s) { return s.lighting == Lighting::Illuminated
 bool isPbr(const RenderSettings& s) { return s.lighting == Lighting::Pbr; }
 bool hasAmbient(const RenderSettings& s) { return s.lighting != Lighting::None; }
 bool hasSsao(const RenderSettings& s) { return s.ssao; }
+bool isTessellatedTubes(const RenderSettings& s) { return s.tube_method == TubeMethod::Tessellation; }
 
 std::vector<SettingInfo> makeTable() {
   std::vector<SettingInfo> t;
@@ -254,6 +264,30 @@ std::vector<SettingInfo> makeTable() {
   anatomy(flag("slab-follows-slice", "slab follows slice",
                "The slab (--slab) lies around the active anatomical slice instead of the focal plane",
                &RenderSettings::slab_follows_slice));
+  // Spline tubes (the viewer's tubes panel; render and bench with --tubes).
+  auto tubes = [&](SettingInfo info) {
+    info.group = "tubes";
+    t.push_back(info);
+  };
+  tubes(choice("tube-method", "method",
+               "compute (ray casting in compute, tiles: lavapipe, compute-only GPUs) | raycast (ray casting in the "
+               "fragment shader, one box per sub-segment) | tess (tessellated cylinders)",
+               3, [](int v) { return tubeMethodName(TubeMethod(v)); },
+               getChoice<TubeMethod, &RenderSettings::tube_method>, setChoice<TubeMethod, &RenderSettings::tube_method>));
+  tubes(with(integer("tube-rings", "rings", "Tessellated tubes: rings of the base mesh per segment before refinement",
+                     &RenderSettings::tube_rings, 2, 64),
+             isTessellatedTubes));
+  tubes(with(integer("tube-vertices", "vertices", "Tessellated tubes: vertices per ring of the base mesh",
+                     &RenderSettings::tube_vertices, 3, 64),
+             isTessellatedTubes));
+  tubes(with(choice("tube-msaa", "MSAA", "Tessellated tubes: samples per pixel, 1 | 4 | 8", 3,
+                    [](int v) { return std::string_view(v == 0 ? "1" : (v == 1 ? "4" : "8")); },
+                    [](const RenderSettings& s) {
+                      return s.tube_msaa == 8 ? 2 : (s.tube_msaa == 4 ? 1 : (s.tube_msaa == 1 ? 0 : -1));
+                    },
+                    // Outside the names: 0 samples, which validation rejects.
+                    [](RenderSettings& s, int v) { s.tube_msaa = v == 0 ? 1 : (v == 1 ? 4 : (v == 2 ? 8 : 0)); }),
+             isTessellatedTubes));
   return t;
 }
 

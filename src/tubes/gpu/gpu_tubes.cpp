@@ -42,7 +42,7 @@ FrameStageList withTubeStage(FrameStageList stages, const GpuTubes* tubes) {
     const Factory* f = at->target<Factory>();
     if (f && *f == &makeSurfaceMergeStage) break;
   }
-  stages.insert(at, tubeRaycastStage(tubes));
+  stages.insert(at, tubeStage(tubes));
   return stages;
 }
 

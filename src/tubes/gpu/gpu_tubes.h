@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string_view>
 
 #include "gpu/buffer.h"
 #include "gpu/vulkan_context.h"
@@ -31,7 +32,15 @@ void destroyTubes(const gpu::VulkanContext& context, GpuTubes& tubes);
 // every frame and must outlive the renderer.
 FrameStageFactory tubeRaycastStage(const GpuTubes* tubes);
 
-// `stages` with the tube stage inserted before the surface merge (at the
+// The tube methods name their timed passes "tube ..." (render's and
+// bench's tube time is their sum).
+inline bool isTubePass(std::string_view name) { return name.starts_with("tube "); }
+
+// Surfaces: the tubes by the frame's RenderSettings::tube_method
+// (tube_stage.cpp: compute, raycast or tess), switchable frame to frame.
+FrameStageFactory tubeStage(const GpuTubes* tubes);
+
+// `stages` with tubeStage(tubes) inserted before the surface merge (at the
 // end when the list has none).
 FrameStageList withTubeStage(FrameStageList stages, const GpuTubes* tubes);
 
