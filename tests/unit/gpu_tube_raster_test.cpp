@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <bit>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <string>
@@ -346,8 +347,9 @@ TEST_F(GpuTubeRaster, anEmptyModelDrawsNothing) {
 // Opt-in (FIBSCOPE_TUBE_BENCH=1): the two variants side by side on the
 // first 300 fibers of the 2,000-fiber phantom as tubes of 0.3 mm
 // (resampled within radius / 20, as the command line does), 800 x 600,
-// camera fitted to the phantom; GPU time of each variant's passes, the
-// third of three frames.
+// camera fitted to the phantom (from -y); GPU time of each variant's
+// passes and the wall time of the frame (setup + tubes, submitted and
+// waited for), the third of three frames.
 TEST_F(GpuTubeRaster, benchComputeAgainstFragmentVariant) {
   const char* env = std::getenv("FIBSCOPE_TUBE_BENCH");
   if (!env || std::string(env) != "1") GTEST_SKIP() << "set FIBSCOPE_TUBE_BENCH=1 to run the benchmark";
@@ -370,7 +372,12 @@ TEST_F(GpuTubeRaster, benchComputeAgainstFragmentVariant) {
     for (int v = 0; v < 2; ++v) {
       FrameRenderer renderer(context(), camera.width, camera.height, {makeSetupStage, makers[v](&tubes)});
       FrameStats stats;
-      for (int frame = 0; frame < 3; ++frame) stats = renderer.render(camera, RenderSettings(), GpuScene());
+      double wall_ms = 0;
+      for (int frame = 0; frame < 3; ++frame) {
+        const auto start = std::chrono::steady_clock::now();
+        stats = renderer.render(camera, RenderSettings(), GpuScene());
+        wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+      }
       double total = 0;
       std::string passes;
       for (const PassTiming& p : stats.passes)
@@ -381,8 +388,8 @@ TEST_F(GpuTubeRaster, benchComputeAgainstFragmentVariant) {
       images[v] = downloadSurface(context(), renderer.targets());
       size_t covered = 0;
       for (const shader::SurfaceTexel& t : images[v]) covered += t.depth < 1.0f;
-      std::printf("tube bench %s: %zu segments, %zu px covered, tube passes %.1f ms:%s\n", names[v],
-                  model.segments.size(), covered, total, passes.c_str());
+      std::printf("tube bench %s: %zu segments, %zu px covered, frame %.1f ms wall, tube passes %.1f ms:%s\n", names[v],
+                  model.segments.size(), covered, wall_ms, total, passes.c_str());
     }
   } catch (...) {
     destroyTubes(context(), tubes);
