@@ -5,8 +5,8 @@
 // a time into shared memory as quadratics with their boxes; each pixel's
 // eye ray is tested against the boxes and then intersected
 // (glsl/tube_intersect.glsl), the nearest front hit kept against the
-// surface texel's depth and written: depth, fiber, normal, tangent,
-// position along the fiber, the colour interpolated between the nodes.
+// surface texel's depth and written (glsl/tube_texel.glsl, shared with the
+// fragment-shader variant's resolve).
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_buffer_reference : require
@@ -17,6 +17,7 @@
 #include "glsl/shade_common.glsl"
 #include "glsl/tangent.glsl"
 #include "glsl/tube_intersect.glsl"
+#include "glsl/tube_texel.glsl"
 
 // kTubeTileSize x kTubeTileSize
 layout(local_size_x_id = WORKGROUP_SIZE_X_ID, local_size_y_id = WORKGROUP_SIZE_Y_ID) in;
@@ -34,10 +35,6 @@ shared TubeQuadratic s_quads[kBatch];
 shared vec3 s_lo[kBatch];
 shared vec3 s_hi[kBatch];
 shared uint s_items[kBatch];
-
-// Colour of node n as RGBA in [0, 1] and its slope per mm.
-vec4 nodeColor(TubeNode n) { return unpackUnorm4x8(n.color); }
-vec4 nodeColorSlope(TubeNode n) { return unpackSnorm4x8(n.color_slope) * kTubeColorSlopeMax; }
 
 void main() {
   const uvec2 tile = gl_WorkGroupID.xy;
@@ -95,29 +92,5 @@ void main() {
   if (!inside || best_item == 0xFFFFFFFFu) return;
   const TubeSegment s = SegmentsRef(pc.segments).segments[best_item / 2u];
   const TubeNode a = NodesRef(pc.nodes).nodes[s.node], b = NodesRef(pc.nodes).nodes[s.node + 1u];
-  const uint which_half = best_item % 2u;
-  const TubeQuadratic q = tubeQuadratic(a, b, s.chord, which_half);
-  const vec3 hit = o + best_s * d;
-  // Position along the segment, u in [0, 1]: the halves split it at 1/2.
-  const float u = 0.5 * (float(which_half) + best_t);
-  SurfaceTexel texel;
-  texel.depth = best_depth;
-  texel.fiber = s.fiber;
-  texel.normal = packSegmentTangent(hit - tubeQuadraticCenter(q, best_t));
-  // The centre line's direction; a one-point tube (a sphere, no
-  // direction) takes its normal, as sphere_surface.comp does.
-  const vec3 dq = tubeQuadraticDerivative(q, best_t);
-  texel.tangent = dot(dq, dq) > 0.0 ? packSegmentTangent(dq) : texel.normal;
-  texel.position = mix(a.point, b.point, u);
-  texel.color = 0u;
-  if (a.color >> 24 != 0u || b.color >> 24 != 0u) {
-    // Hermite in the colour, slopes per mm times the chord.
-    const float u2 = u * u, u3 = u2 * u;
-    const vec4 col = (2.0 * u3 - 3.0 * u2 + 1.0) * nodeColor(a) + (u3 - 2.0 * u2 + u) * s.chord * nodeColorSlope(a) +
-                     (-2.0 * u3 + 3.0 * u2) * nodeColor(b) + (u3 - u2) * s.chord * nodeColorSlope(b);
-    texel.color = packUnorm4x8(vec4(clamp(col.rgb, 0.0, 1.0), 1.0));
-  }
-  texel.source = kSurfaceSourceTube;
-  texel.pad0 = 0u;
-  SurfaceRef(pc.surface).texels[index] = texel;
+  SurfaceRef(pc.surface).texels[index] = tubeSurfaceTexel(s, a, b, best_item, o + best_s * d, best_t, best_depth);
 }

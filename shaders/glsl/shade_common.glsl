@@ -11,7 +11,9 @@
 // (kPixelGroupSize x kPixelGroupSize) per listed tile (tile_classify.comp):
 // the flattened workgroup index picks the tile, the local id the pixel in
 // it. False past the list's end (the 2D grid may overshoot) and outside the
-// frame.
+// frame. Compute shaders only: a graphics stage (tube_box.frag, for
+// pixelToEye) defines SHADE_COMMON_NO_TILES before the include.
+#ifndef SHADE_COMMON_NO_TILES
 bool tilePixel(uint64_t tiles, uint width, uint height, out uvec2 p) {
   p = uvec2(0u);
   TileListRef list = TileListRef(tiles);
@@ -21,6 +23,7 @@ bool tilePixel(uint64_t tiles, uint width, uint height, out uvec2 p) {
   p = uvec2(tile % tiles_x, tile / tiles_x) * kPixelGroupSize + gl_LocalInvocationID.xy;
   return p.x < width && p.y < height;
 }
+#endif
 
 // Distance along the view axis (mm) of clip depth d = z/w in [0, 1]:
 // camera.cpp's projection gives d = f (z - n) / ((f - n) z) for z the

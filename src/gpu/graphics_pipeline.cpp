@@ -99,7 +99,8 @@ GraphicsPipeline createGraphicsPipeline(const VulkanContext& context, const Grap
     blend_attachment.colorWriteMask =
         VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
     VkPipelineColorBlendStateCreateInfo blend{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
-    blend.attachmentCount = 1;
+    const bool has_color = desc.color_format != VK_FORMAT_UNDEFINED;
+    blend.attachmentCount = has_color ? 1 : 0;
     blend.pAttachments = &blend_attachment;
     const VkDynamicState dynamic_states[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR,
                                              VK_DYNAMIC_STATE_LINE_WIDTH};
@@ -107,8 +108,8 @@ GraphicsPipeline createGraphicsPipeline(const VulkanContext& context, const Grap
     dynamic.dynamicStateCount = desc.dynamic_line_width ? 3 : 2;
     dynamic.pDynamicStates = dynamic_states;
     VkPipelineRenderingCreateInfo rendering{VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO};
-    rendering.colorAttachmentCount = 1;
-    rendering.pColorAttachmentFormats = &desc.color_format;
+    rendering.colorAttachmentCount = has_color ? 1 : 0;
+    rendering.pColorAttachmentFormats = has_color ? &desc.color_format : nullptr;
     rendering.depthAttachmentFormat = desc.depth_format;
 
     VkGraphicsPipelineCreateInfo info{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
@@ -176,6 +177,17 @@ void beginRendering(VkCommandBuffer cmd, Image& color, const VkClearColorValue& 
   vkCmdBeginRendering(cmd, &info);
   const VkViewport viewport{0, 0, float(color.extent.width), float(color.extent.height), 0, 1};
   const VkRect2D scissor{{0, 0}, color.extent};
+  vkCmdSetViewport(cmd, 0, 1, &viewport);
+  vkCmdSetScissor(cmd, 0, 1, &scissor);
+}
+
+void beginRenderingWithoutAttachments(VkCommandBuffer cmd, uint32_t width, uint32_t height) {
+  VkRenderingInfo info{VK_STRUCTURE_TYPE_RENDERING_INFO};
+  info.renderArea = {{0, 0}, {width, height}};
+  info.layerCount = 1;
+  vkCmdBeginRendering(cmd, &info);
+  const VkViewport viewport{0, 0, float(width), float(height), 0, 1};
+  const VkRect2D scissor{{0, 0}, {width, height}};
   vkCmdSetViewport(cmd, 0, 1, &viewport);
   vkCmdSetScissor(cmd, 0, 1, &scissor);
 }

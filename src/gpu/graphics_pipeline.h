@@ -26,10 +26,10 @@ struct GraphicsPipelineDesc {
   std::string_view tess_evaluation_shader;
   uint32_t patch_control_points = 0;
   VkPrimitiveTopology topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
-  VkFormat color_format = VK_FORMAT_R8G8B8A8_UNORM;
-  VkFormat depth_format = VK_FORMAT_UNDEFINED;  // UNDEFINED: no depth test
-  bool primitive_restart = false;               // strips: index 0xffffffff ends one
-  uint32_t push_constant_bytes = 0;             // visible to every stage of the pipeline
+  VkFormat color_format = VK_FORMAT_R8G8B8A8_UNORM;  // UNDEFINED: no colour attachment
+  VkFormat depth_format = VK_FORMAT_UNDEFINED;       // UNDEFINED: no depth test
+  bool primitive_restart = false;                    // strips: index 0xffffffff ends one
+  uint32_t push_constant_bytes = 0;                  // visible to every stage of the pipeline
   // The line width is dynamic state (vkCmdSetLineWidth before drawing;
   // widths other than 1 need the wideLines feature).
   bool dynamic_line_width = false;
@@ -40,7 +40,7 @@ struct GraphicsPipeline {
   VkPipelineLayout layout = VK_NULL_HANDLE;
   uint32_t push_constant_bytes = 0;
   VkShaderStageFlags stages = 0;  // the pipeline's stages: the push constants' range
-  std::string name;  // "vertex + fragment", for messages
+  std::string name;               // "vertex + fragment", for messages
 };
 
 // Viewport and scissor are dynamic state (set by beginRendering). Throws
@@ -54,6 +54,10 @@ void destroyGraphicsPipeline(const VulkanContext& context, GraphicsPipeline& pip
 // sets the viewport and scissor to it. The previous contents are discarded.
 void beginRendering(VkCommandBuffer cmd, Image& color, const VkClearColorValue& clear_color, Image* depth = nullptr,
                     float clear_depth = 1.0f);
+// Dynamic rendering of a width x height area without attachments, for
+// passes whose fragment shaders only write storage buffers (the pipeline's
+// color_format and depth_format UNDEFINED); sets the viewport and scissor.
+void beginRenderingWithoutAttachments(VkCommandBuffer cmd, uint32_t width, uint32_t height);
 void endRendering(VkCommandBuffer cmd);
 
 // Binds the pipeline, pushes `push` (its size must be the pipeline's; a

@@ -133,6 +133,8 @@ VulkanContext::VulkanContext(const ContextOptions& options) : instance_(options.
   // device has the stages; without them those pipelines are refused in one
   // line.
   features.features.geometryShader = available.geometryShader;
+  // The fragment-shader tube caster's atomicMin into its visibility buffer.
+  features.features.fragmentStoresAndAtomics = available.fragmentStoresAndAtomics;
   features.features.tessellationShader = available.tessellationShader;
   enabled_ = features.features;
 
