@@ -240,24 +240,6 @@ TEST_F(GpuTubeRaster, fragmentAndComputeVariantsAgreeWhereTileListsOverflow) {
   EXPECT_LE(a.fiber_mismatch, a.both / 50) << a.summary();  // tubes overlapping within float depth
 }
 
-// `stages` with the fragment-shader tube stage before the surface merge:
-// withTubeStage's list with its compute stage swapped for it.
-FrameStageList withRasterTubeStage(const GpuTubes* tubes) {
-  FrameStageList stages = withTubeStage(standardFrameStages(), tubes);
-  const size_t plain = standardFrameStages().size();
-  // withTubeStage's stage is the lambda just before the surface merge.
-  using Factory = std::unique_ptr<FrameStage> (*)(const gpu::VulkanContext&);
-  for (size_t i = 0; i + 1 < stages.size(); ++i) {
-    const Factory* next = stages[i + 1].target<Factory>();
-    if (!stages[i].target<Factory>() && next && *next == &makeSurfaceMergeStage) {
-      stages[i] = tubeRasterRaycastStage(tubes);
-      break;
-    }
-  }
-  EXPECT_EQ(stages.size(), plain + 1);
-  return stages;
-}
-
 // As the compute variant's test (tube_test_scenes.h's lines-and-tubes
 // scene, seen from +z): tube pixels where the reference tube is nearer
 // than the reference lines, line pixels where the lines are nearer.
@@ -284,13 +266,14 @@ TEST_F(GpuTubeRaster, tubesAndLinesOccludeEachOtherBothWaysAsTheReferences) {
   const GpuRawTractogram raw = GpuRawTractogram::upload(context(), setup.lines, "lines");
   GpuTubes tubes = uploadTubes(context(), model);
   try {
-    FrameRenderer renderer(context(), w, h, withRasterTubeStage(&tubes));
+    FrameRenderer renderer(context(), w, h, withTubeStage(standardFrameStages(), &tubes));
     const GpuScene scene(&upload.dataset, &raw);
     for (const RenderPipeline pipeline : {RenderPipeline::Compute, RenderPipeline::RawCompute}) {
       SCOPED_TRACE(std::string(renderPipelineName(pipeline)));
       RenderSettings settings;
       settings.pipeline = pipeline;
       settings.line_width_px = 2.0f;
+      settings.tube_method = TubeMethod::Raycast;  // the tube stage draws by the frame's method
       const FrameStats stats = renderer.render(camera, settings, scene);
       const auto texels = downloadGBuffer(context(), renderer.targets());
       std::vector<uint8_t> got_tube, got_line;
