@@ -212,6 +212,37 @@ TEST_F(GpuTubeRaster, fragmentAndComputeVariantsWriteTheSameTexelsOnAOnePointSph
   EXPECT_LE(a.max_depth_mm, 2e-4) << a.summary();
 }
 
+// The tube stage (tubeStage: the method by RenderSettings::tube_method,
+// frame to frame in one renderer) draws what each method's own stage
+// draws, texel for texel, and switching back gives the first frame again.
+TEST_F(GpuTubeRaster, theTubeStageSwitchesMethodsFrameToFrameAsTheirOwnStagesDraw) {
+  const test::TubeScene scene = test::tubeScenes().front();  // a copy: tubeScenes() returns by value
+  const TubeModel model = buildTubes(scene.tractogram, scene.options);
+  const Camera camera = test::tubeSceneCameras(scene, 96, 72).front();
+  const std::vector<shader::SurfaceTexel> compute = cast(model, camera, tubeRaycastStage);
+  const std::vector<shader::SurfaceTexel> raster = cast(model, camera, tubeRasterRaycastStage);
+  GpuTubes tubes = uploadTubes(context(), model);
+  try {
+    FrameRenderer renderer(context(), camera.width, camera.height, {makeSetupStage, tubeStage(&tubes)});
+    const auto frame = [&](TubeMethod method, const char* pass) {
+      RenderSettings settings;
+      settings.tube_method = method;
+      const FrameStats stats = renderer.render(camera, settings, GpuScene());
+      bool timed = false;
+      for (const PassTiming& p : stats.passes) timed |= p.name == pass;
+      EXPECT_TRUE(timed) << pass;
+      return downloadSurface(context(), renderer.targets());
+    };
+    expectSameTexels(compareVariants(frame(TubeMethod::Compute, "tube raycast"), compute), "compute");
+    expectSameTexels(compareVariants(frame(TubeMethod::Raycast, "tube boxes"), raster), "raycast");
+    expectSameTexels(compareVariants(frame(TubeMethod::Compute, "tube raycast"), compute), "compute again");
+  } catch (...) {
+    destroyTubes(context(), tubes);
+    throw;
+  }
+  destroyTubes(context(), tubes);
+}
+
 // 300 short tubes piled in the same few tiles (the compute test's scene):
 // over kTubeTileCapacity sub-segments a tile, where the compute caster
 // tests every sub-segment; the boxes need no lists.
