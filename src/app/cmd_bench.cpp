@@ -87,6 +87,7 @@ struct Variant {
   bool tubes = false;  // draws the tubes (--tubes; "none" in --tube-compare: not)
   RenderSettings settings;
   std::vector<double> gpu_ms, wall_ms, drawn_fraction, lod_fraction, tube_ms;
+  uint64_t tube_method_bytes = 0;  // the largest seen
   std::map<std::string, double> pass_ms_sum;
   std::vector<std::string> pass_order;
   uint64_t segments_drawn_sum = 0;
@@ -304,6 +305,7 @@ void runBench(const BenchOptions& o) {
         v.pass_ms_sum[p.name] += p.ms;
       }
       if (v.tubes) v.tube_ms.push_back(tube_ms);
+      v.tube_method_bytes = std::max(v.tube_method_bytes, stats.tube_method_bytes);
     }
     // The reference after the variants: an occlusion variant's first frame
     // computes the datasets' exact fiblet spheres, which the frustum test
@@ -390,6 +392,7 @@ void runBench(const BenchOptions& o) {
       j["tube_method"] = tubeMethodName(v.settings.tube_method);
       j["tube_mean_ms"] = mean(v.tube_ms);
       j["tube_median_ms"] = percentile(v.tube_ms, 50);
+      j["tube_method_bytes"] = v.tube_method_bytes;
     }
     j["wall_median_ms"] = percentile(v.wall_ms, 50);
     j["median_ratio_to_first"] = base_median > 0 ? ratioTime(v) / base_median : 0.0;
@@ -417,9 +420,9 @@ void runBench(const BenchOptions& o) {
       if (variants.size() > 1) std::printf("   x%.2f of %s", base_median > 0 ? ratioTime(v) / base_median : 0.0,
                                            variants.front().label.c_str());
       if (!v.tube_ms.empty())
-        std::printf("\n    tubes by %s: mean %.3f ms, median %.3f ms (their passes' GPU time)",
+        std::printf("\n    tubes by %s: mean %.3f ms, median %.3f ms (their passes' GPU time), its buffers %.2f MiB",
                     std::string(tubeMethodName(v.settings.tube_method)).c_str(), mean(v.tube_ms),
-                    percentile(v.tube_ms, 50));
+                    percentile(v.tube_ms, 50), double(v.tube_method_bytes) / double(1 << 20));
       std::printf("\n    passes:");
       for (const std::string& name : v.pass_order) std::printf(" %s %.3f", name.c_str(), v.pass_ms_sum[name] / double(measured));
       std::printf(" (mean ms)\n");

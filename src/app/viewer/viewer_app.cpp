@@ -858,6 +858,7 @@ void ViewerApp::apply(const ViewerAction& action) {
           state_.tubes.selection = a.selection;
           state_.tubes.filtered = a.filtered;
           if (a.radius_mm > 0) state_.tubes.radius_mm = a.radius_mm;
+          if (state_.tubes.wanted()) state_.show_tubes = true;  // as the panel's switches open it
         } else if constexpr (std::is_same_v<A, AnatomyAction>) {
           loadAnatomy(a.path);
         } else if constexpr (std::is_same_v<A, SliceStepAction>) {
