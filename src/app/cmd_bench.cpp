@@ -33,6 +33,7 @@
 #include "core/error.h"
 #include "render/camera.h"
 #include "render/gpu/frame_renderer.h"
+#include "svo/gpu/gpu_svo.h"
 #include "tubes/gpu/gpu_tubes.h"
 
 namespace fibscope {
@@ -46,6 +47,11 @@ struct BenchOptions {
   // (compute, raycast, tess), all on the same frames.
   TubeCliOptions tubes;
   std::string tube_compare;
+  // SVO streamtubes (issue 16 item 5): --pipeline (or a --compare entry)
+  // svo-straight | svo-curved draws the fibers of --tubes (all by default)
+  // ray-traced from the octree over the compute pipeline's lines; --voxel
+  // as render's.
+  float voxel_mm = 0.0f;
   uint32_t frames = 316;
   double step_deg = 1.14;
   double elevation_deg = 0;
@@ -85,6 +91,7 @@ std::vector<OrbitFrame> orbitFrames(const BenchOptions& o) {
 struct Variant {
   std::string label;  // "compute/two-phase"
   bool tubes = false;  // draws the tubes (--tubes; "none" in --tube-compare: not)
+  int svo = -1;        // the octree it traces: 0 straight, 1 curved; -1 none
   RenderSettings settings;
   std::vector<double> gpu_ms, wall_ms, drawn_fraction, lod_fraction, tube_ms;
   uint64_t tube_method_bytes = 0;  // the largest seen
@@ -107,11 +114,27 @@ void countMissed(const std::vector<uint64_t>& reference, const std::vector<uint6
   v.changed_pixels.push_back(changed);
 }
 
-std::vector<Variant> variantsFrom(const BenchOptions& o) {
+constexpr std::string_view kSvoPipelines[] = {"svo-straight", "svo-curved"};
+
+int svoKind(std::string_view pipeline) {
+  for (int k = 0; k < 2; ++k)
+    if (pipeline == kSvoPipelines[k]) return k;
+  return -1;
+}
+
+std::vector<Variant> variantsFrom(BenchOptions o) {
+  // --pipeline svo-*: the compute pipeline's lines under the octree's tubes.
+  std::string base_spec;
+  if (const auto p = o.render.values.find("pipeline"); p != o.render.values.end() && svoKind(p->second) >= 0) {
+    base_spec = p->second;
+    p->second = "compute";
+  }
   const RenderSettings base = renderSettingsFrom(o.render);
   std::vector<std::string> specs;
   if (o.compare.empty()) {
-    specs.push_back(std::string(renderPipelineName(base.pipeline)) + "/" + std::string(cullingModeName(base.culling)));
+    specs.push_back(!base_spec.empty() ? base_spec
+                                       : std::string(renderPipelineName(base.pipeline)) + "/" +
+                                             std::string(cullingModeName(base.culling)));
   } else {
     size_t start = 0;
     while (start <= o.compare.size()) {
@@ -128,6 +151,10 @@ std::vector<Variant> variantsFrom(const BenchOptions& o) {
     if (comma == std::string::npos) break;
     start = comma + 1;
   }
+  bool svo = false;
+  for (const std::string& spec : specs) svo |= svoKind(spec.substr(0, spec.find('/'))) >= 0;
+  if (svo && o.tubes.requested() && !tube_methods.empty())
+    throw Error("--tube-compare: not with an svo pipeline (its tubes come from the octree)");
   if (!tube_methods.empty() && !o.tubes.requested())
     throw Error("--tube-compare: give the tubes to draw (--tubes FIBERS|all|filtered)");
   std::vector<Variant> variants;
@@ -135,6 +162,15 @@ std::vector<Variant> variantsFrom(const BenchOptions& o) {
     Variant v;
     v.settings = base;
     const size_t slash = spec.find('/');
+    if (const int kind = svoKind(spec.substr(0, slash)); kind >= 0) {
+      if (!tube_methods.empty()) throw Error("--tube-compare: not with " + spec + " (its tubes come from the octree)");
+      v.svo = kind;
+      v.settings.pipeline = RenderPipeline::Compute;
+      if (slash != std::string::npos) v.settings.culling = parseCullingMode(spec.substr(slash + 1));
+      v.label = spec.substr(0, slash) + "/" + std::string(cullingModeName(v.settings.culling));
+      variants.push_back(std::move(v));
+      continue;
+    }
     v.settings.pipeline = parseRenderPipeline(spec.substr(0, slash));
     if (slash != std::string::npos) v.settings.culling = parseCullingMode(spec.substr(slash + 1));
     v.label = std::string(renderPipelineName(v.settings.pipeline));
@@ -186,15 +222,35 @@ void runBench(const BenchOptions& o) {
   for (const Variant& v : variants) need_points |= !drawsFiblets(v.settings.pipeline);
 
   auto context = createRenderContext(o.render);
-  // The tubes' buffers, read by every renderer's tube stage at each frame
-  // and released (by `tubes_owner`) before the renderers and the device.
+  // The tubes' buffers and the octrees, read by the renderers' tube and
+  // SVO stages at each frame and released (by `tubes_owner`) before the
+  // renderers and the device.
   GpuTubes tubes;
+  GpuSvo svos[2];
   struct TubesOwner {
     const gpu::VulkanContext& context;
     GpuTubes& tubes;
-    ~TubesOwner() { destroyTubes(context, tubes); }
+    GpuSvo* svos;
+    ~TubesOwner() {
+      for (int k = 0; k < 2; ++k) destroySvo(context, svos[k]);
+      destroyTubes(context, tubes);
+    }
   };
   std::optional<TubesOwner> tubes_owner;
+  bool svo_used[2] = {false, false};
+  for (const Variant& v : variants)
+    if (v.svo >= 0) svo_used[v.svo] = true;
+  TubeCliOptions tube_options = o.tubes;
+  if (svo_used[0] || svo_used[1]) {
+    // As render's: every fiber by default, and the fibers' own points
+    // (straight and curved tubes share their nodes).
+    if (tube_options.fibers.empty()) tube_options.fibers = "all";
+    if (tube_options.resample_tolerance_mm < 0.0f) tube_options.resample_tolerance_mm = 0.0f;
+  }
+  if (o.voxel_mm != 0.0f && !(svo_used[0] || svo_used[1]))
+    throw Error("--voxel: only with an svo-straight or svo-curved pipeline");
+  if (!(o.voxel_mm >= 0.0f) || !std::isfinite(o.voxel_mm))
+    throw Error("--voxel: expected a voxel size > 0 mm, got " + std::to_string(o.voxel_mm));
   SceneOptions scene_options;
   scene_options.path = o.render.input;
   scene_options.phantom_streamlines = o.render.phantom_streamlines;
@@ -217,13 +273,30 @@ void runBench(const BenchOptions& o) {
   std::vector<GpuScene> variant_scenes(variants.size(), gpu_scene);
   for (size_t i = 0; i < variants.size(); ++i) filter.apply(variant_scenes[i], variants[i].settings.pipeline);
   TubeBuildStats tube_stats;
-  if (o.tubes.requested()) {
+  if (tube_options.requested()) {
     std::vector<uint32_t> kept;
     if (filter.active()) kept = filter.keptFibers();
-    const TubeModel model = loadTubeModel(o.render.input, o.render.phantom_streamlines, o.tubes, &tube_stats,
+    const TubeModel model = loadTubeModel(o.render.input, o.render.phantom_streamlines, tube_options, &tube_stats,
                                           filter.active() ? &kept : nullptr);
     tubes = uploadTubes(*context, model);
-    tubes_owner.emplace(*context, tubes);  // in place: a moved-from temporary would free them
+    tubes_owner.emplace(*context, tubes, svos);  // in place: a moved-from temporary would free them
+    for (int k = 0; k < 2; ++k) {
+      if (!svo_used[k]) continue;
+      SvoGpuBuildOptions build;
+      build.progress = true;
+      SvoGpuBuildStats svo_stats;
+      const SvoTree tree = buildSvoGpu(*context, model, tubes, chooseSvoGrid(model, o.voxel_mm, k == 1), build,
+                                       &svo_stats);
+      svos[k] = uploadSvo(*context, tree);
+      const std::string line = svoBuildSummary(model, tree, svo_stats);
+      if (!o.json) std::printf("%s: %s\n", std::string(kSvoPipelines[k]).c_str(), line.c_str());
+      out["svo"][std::string(kSvoPipelines[k])]["summary"] = line;
+      out["svo"][std::string(kSvoPipelines[k])]["node_bytes"] = tree.nodeBytes();
+      out["svo"][std::string(kSvoPipelines[k])]["decoration_bytes"] = tree.decorationBytes();
+      out["svo"][std::string(kSvoPipelines[k])]["leaves"] = tree.leaves;
+      out["svo"][std::string(kSvoPipelines[k])]["leaves_over_4"] = tree.leaves_over_4;
+      out["svo"][std::string(kSvoPipelines[k])]["build_s"] = svo_stats.voxelize_s + svo_stats.sort_s + svo_stats.tree_s;
+    }
     out["tubes"]["fibers"] = tube_stats.tubes;
     out["tubes"]["nodes"] = tube_stats.nodes;
     out["tubes"]["input_points"] = tube_stats.input_points;
@@ -239,7 +312,9 @@ void runBench(const BenchOptions& o) {
   for (size_t i = 0; i < variants.size(); ++i)
     renderers.push_back(std::make_unique<FrameRenderer>(
         *context, width, height,
-        variants[i].tubes ? withTubeStage(standardFrameStages(), &tubes) : standardFrameStages()));
+        variants[i].svo >= 0 ? withSvoStage(standardFrameStages(), &svos[variants[i].svo], &tubes)
+        : variants[i].tubes  ? withTubeStage(standardFrameStages(), &tubes)
+                             : standardFrameStages()));
   // --count-missed: the unculled frame each culled compute variant is
   // compared with (the first compute variant's settings, culling off).
   // With LoD on, frustum culling with the same LoD instead: culling off
@@ -300,11 +375,11 @@ void runBench(const BenchOptions& o) {
               : scene.segments;
       double tube_ms = 0;
       for (const PassTiming& p : stats.passes) {
-        if (isTubePass(p.name)) tube_ms += p.ms;
+        if (isTubePass(p.name) || p.name == "svo trace") tube_ms += p.ms;
         if (!v.pass_ms_sum.count(p.name)) v.pass_order.push_back(p.name);
         v.pass_ms_sum[p.name] += p.ms;
       }
-      if (v.tubes) v.tube_ms.push_back(tube_ms);
+      if (v.tubes || v.svo >= 0) v.tube_ms.push_back(tube_ms);
       v.tube_method_bytes = std::max(v.tube_method_bytes, stats.tube_method_bytes);
     }
     // The reference after the variants: an occlusion variant's first frame
@@ -389,7 +464,7 @@ void runBench(const BenchOptions& o) {
     }
     j["segments_drawn_per_ms"] = segments_per_ms;
     if (!v.tube_ms.empty()) {
-      j["tube_method"] = tubeMethodName(v.settings.tube_method);
+      j["tube_method"] = v.svo >= 0 ? kSvoPipelines[v.svo] : tubeMethodName(v.settings.tube_method);
       j["tube_mean_ms"] = mean(v.tube_ms);
       j["tube_median_ms"] = percentile(v.tube_ms, 50);
       j["tube_method_bytes"] = v.tube_method_bytes;
@@ -421,7 +496,8 @@ void runBench(const BenchOptions& o) {
                                            variants.front().label.c_str());
       if (!v.tube_ms.empty())
         std::printf("\n    tubes by %s: mean %.3f ms, median %.3f ms (their passes' GPU time), its buffers %.2f MiB",
-                    std::string(tubeMethodName(v.settings.tube_method)).c_str(), mean(v.tube_ms),
+                    std::string(v.svo >= 0 ? kSvoPipelines[v.svo] : tubeMethodName(v.settings.tube_method)).c_str(),
+                    mean(v.tube_ms),
                     percentile(v.tube_ms, 50), double(v.tube_method_bytes) / double(1 << 20));
       std::printf("\n    passes:");
       for (const std::string& name : v.pass_order) std::printf(" %s %.3f", name.c_str(), v.pass_ms_sum[name] / double(measured));
@@ -448,12 +524,15 @@ void addBenchCommand(CLI::App& app) {
   addRenderCliOptions(cmd, o->render);
   cmd->add_option("--compare", o->compare,
                   "Pipelines drawn on the same frames, e.g. compute/two-phase,compute/coverage,compute/none,lines,"
-                  "raw-compute,geometry/frustum,tessellation/none; ratios are to the first");
+                  "raw-compute,geometry/frustum,tessellation/none,svo-straight,svo-curved; ratios are to the first");
   addTubeCliOptions(cmd, o->tubes);
   cmd->add_option("--tube-compare", o->tube_compare,
                   "Tube methods drawn on the same frames, each with every --compare pipeline: none,compute,raycast,tess "
                   "(with --tubes; none: without tubes, the baseline of the tubes' wall time); the seed's protocol: --frames 500 --step 0.72 --size 800x600|1200x768, far "
                   "--distance 1, close --distance 0.3");
+  cmd->add_option("--voxel", o->voxel_mm,
+                  "Voxel size of the octree in mm for svo-straight and svo-curved (--pipeline or --compare; default: "
+                  "from the tube radius and the step)");
   cmd->add_option("--frames", o->frames, "Measured frames")->capture_default_str();
   cmd->add_option("--step", o->step_deg, "Orbit step per frame, degrees")->capture_default_str();
   cmd->add_option("--elevation", o->elevation_deg, "Orbit elevation, degrees")->capture_default_str();
