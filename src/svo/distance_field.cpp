@@ -57,7 +57,7 @@ DistanceFieldGrid chooseDistanceFieldGrid(const TubeModel& model, float voxel_mm
                   " MB), more than " + std::to_string(double(max_bytes) / 1e6) + " MB: choose a larger --df-voxel");
     grid.voxel = voxel;
     grid.band = band;
-    grid.size = glm::uvec3(std::max(cells, glm::dvec3(1.0)));
+    grid.size = glm::uvec3(glm::max(cells, glm::dvec3(1.0)));
     // Centred on the tubes' box.
     grid.origin = 0.5f * (lo + hi) - 0.5f * glm::vec3(grid.size) * voxel;
     return grid;

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include <glm/geometric.hpp>
+#include <glm/vec2.hpp>
 
 #include "gpu_test_context.h"
 #include "svo_test_scenes.h"

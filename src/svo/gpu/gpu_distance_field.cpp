@@ -1,8 +1,10 @@
 #include "svo/gpu/gpu_distance_field.h"
 
+#include <algorithm>
 #include <chrono>
 
 #include "gpu/compute_pipeline.h"
+#include "gpu/pass_scope.h"
 #include "gpu/submit.h"
 #include "shared/distance_field.h"
 #include "shared/svo.h"
