@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <random>
 #include <vector>
@@ -177,6 +178,8 @@ TEST_F(GpuDfAo, fieldMatchesBruteForceCapsulesWithinTheTrilinearBound) {
     ASSERT_LE(std::abs(got - want), bound + 1e-5f) << "at (" << p.x << ", " << p.y << ", " << p.z << ")";
   }
   EXPECT_GT(near_tubes, 50);
+  std::printf("field %ux%ux%u at %.3f mm: centres within %.2g mm of the capsules' distance\n", grid.size.x,
+              grid.size.y, grid.size.z, grid.voxel, worst_centre);
 }
 
 TEST_F(GpuDfAo, aoAndShadowPerPixelMatchTheCpuFormulasOnTheSameField) {
@@ -213,6 +216,9 @@ TEST_F(GpuDfAo, aoAndShadowPerPixelMatchTheCpuFormulasOnTheSameField) {
       worst_shadow = std::max(worst_shadow, std::abs(shadow - f.shadow[i]) / shadow_tolerance);
       shadowed += shadow < 0.9f;
     }
+  std::printf("%zu covered pixels (%zu with AO < 0.9, %zu with shadow < 0.9): largest error over tolerance AO %.3f, "
+              "shadow %.3f\n",
+              covered, occluded, shadowed, worst_ao, worst_shadow);
   EXPECT_GT(covered, 300u);
   EXPECT_GT(occluded, 30u) << "the bundle should occlude itself";
   EXPECT_GT(shadowed, 10u) << "the bundle should shadow itself";
@@ -266,6 +272,8 @@ TEST_F(GpuDfAo, aTubeLyingOnAWallOfTubesIsDarkerThanAnIsolatedOne) {
   const double ao_isolated = fiberMean(f, f.ao, isolated, n_isolated);
   ASSERT_GT(n_wall, 100u);
   ASSERT_GT(n_isolated, 100u);
+  std::printf("mean AO: tube on the wall %.3f (%zu px), isolated %.3f (%zu px)\n", ao_wall, n_wall, ao_isolated,
+              n_isolated);
   EXPECT_GT(ao_isolated, 0.9) << "an isolated tube hardly occludes itself";
   EXPECT_LT(ao_wall, ao_isolated - 0.05) << "on the wall " << ao_wall << ", isolated " << ao_isolated;
 }
@@ -317,6 +325,8 @@ TEST_F(GpuDfAo, aTubeBehindAnotherTowardsTheLightIsShadowedAnIsolatedOneIsNot) {
   ASSERT_GT(open_pixels, 20u);
   size_t n_shaded = 0, n_open = 0;
   const double shaded_mean = fiberMean(f, f.shadow, shaded, n_shaded), open_mean = fiberMean(f, f.shadow, open, n_open);
+  std::printf("shadow facing the light: behind B min %.3f, in the open min %.3f; means %.3f, %.3f\n", shaded_min,
+              open_min, shaded_mean, open_mean);
   EXPECT_LT(shaded_min, 0.2) << "B's umbra on A";
   EXPECT_GT(open_min, 0.95) << "an isolated tube is unshadowed where it faces the light";
   EXPECT_LT(shaded_mean, open_mean - 0.1) << "A " << shaded_mean << ", C " << open_mean;
