@@ -6,8 +6,9 @@
 // which light a line from its tangent alone: the normal is the one in the
 // plane of T and L that maximises the Phong terms; surfaces: Blinn-Phong
 // from their normal; or PBR: Cook-Torrance under FiberVisualizer's ring of
-// directional lights, lines taking their view-facing normal), times the ambient
-// occlusion factor when ssao.comp ran, unselected fibers faded towards the
+// directional lights, lines taking their view-facing normal; the direct
+// light scaled by df_shadow.comp's factor when it ran), times the ambient
+// occlusion factor when ssao.comp or df_ao.comp ran, unselected fibers faded towards the
 // background when there is a selection, as RGBA8 (R in the low byte,
 // A = 255). Empty pixels get the background colour. Formulas:
 // shared/shade_push.h. Colour mode, lighting and surfaces are
@@ -35,6 +36,7 @@ layout(push_constant, std430) uniform Push { ShadePush pc; };
 
 layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer ShadeBlockRef { ShadeBlock b; };
 layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer AoRef { float values[]; };
+layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer ShadowRef { float values[]; };
 layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer ScalarRef { float values[]; };
 layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer WordRef { uint values[]; };
 layout(buffer_reference, std430, buffer_reference_align = 4) writeonly buffer ColorRef { uint values[]; };
@@ -154,6 +156,7 @@ void main() {
       c = known ? scalarColor(block, ScalarRef(block.b.fiber_scalars).values[texel.fiber]) : abs(t);
     else if (COLOR_MODE == kShadeColorNormal) c = viewNormalColor(cam, surface ? n : viewFacingNormal(t, v));
     else c = unpackRgb8(block.b.solid);
+    const vec3 base = c;
     if (LIGHTING == kShadeLightingIlluminated) {
       const vec3 l = lightDirection(cam);
       const float ambient = block.b.ambient, diffuse_k = block.b.diffuse, specular_k = block.b.specular;
@@ -172,6 +175,9 @@ void main() {
     } else if (LIGHTING == kShadeLightingPbr) {
       c = pbrColor(block, cam, c, surface ? n : viewFacingNormal(t, v), v);
     }
+    // Soft shadows scale the direct light only (shared/shade_push.h).
+    if (LIGHTING != kShadeLightingNone && pc.shadow != 0ul)
+      c = mix(base * block.b.ambient, c, ShadowRef(pc.shadow).values[index]);
     if (pc.ao != 0ul) c *= AoRef(pc.ao).values[index];
     if (dimmed) c = mix(c, background, block.b.dim_unselected);
     if (TRANSLUCENT_SLICES) {

@@ -39,8 +39,10 @@ void main() {
   bmin -= pad;
   bmax += pad;
   const int side = int(pc.side);
+  const uint rows = pc.rows != 0u ? pc.rows : pc.side;
   ivec3 lo = max(ivec3(0), ivec3(floor((bmin - origin) / pc.voxel - 0.5)));
-  ivec3 hi = min(ivec3(side - 1), ivec3(ceil((bmax - origin) / pc.voxel - 0.5)));
+  // z: the slab's range below bounds it.
+  ivec3 hi = min(ivec3(side - 1, int(rows) - 1, 0x7FFFFFFF), ivec3(ceil((bmax - origin) / pc.voxel - 0.5)));
   lo.z = max(lo.z, int(pc.slab_z0));
   hi.z = min(hi.z, int(pc.slab_z0 + pc.slab_depth) - 1);
   if (any(greaterThan(lo, hi))) return;
@@ -52,6 +54,6 @@ void main() {
     float u;
     const float f = curved ? svoCurveDistance(cv, p, u) : svoCapsuleDistance(c, p);
     if (!(f < pc.band)) continue;
-    atomicMin(FieldRef(pc.field).keys[((v.z - pc.slab_z0) * pc.side + v.y) * pc.side + v.x], svoOrderedKey(f));
+    atomicMin(FieldRef(pc.field).keys[((v.z - pc.slab_z0) * rows + v.y) * pc.side + v.x], svoOrderedKey(f));
   }
 }

@@ -191,6 +191,12 @@ struct SsaoBlurPush {
 // (selection_bits != 0): selected fibers take the highlight colour as base;
 // unselected ones end as mix(colour, background, dim_unselected) after
 // lighting and occlusion.
+// Soft shadows (shadow != 0, df_shadow.comp's factor s per pixel): the
+// direct light (diffuse and specular, or PBR's sum over the ring) scales
+// by s, the ambient term not:
+//   colour = base * ambient + s * (lit colour - base * ambient)
+// (no lighting: no shadows); frames without shadows run the formulas
+// above unchanged.
 SHADE_CONST uint kShadeSpecColorMode = 0u;  // constant_id: kShadeColor*
 SHADE_CONST uint kShadeSpecLighting = 1u;   // constant_id: kShadeLighting*
 SHADE_CONST uint kShadeSpecSurfaces = 2u;   // constant_id: 1 when the frame has surfaces
@@ -203,6 +209,7 @@ struct ShadePush {
   uint64_t color;    // uint per pixel (written)
   uint64_t tiles;    // the covered tiles (tile_classify.comp): one workgroup each
   uint64_t block;    // ShadeBlock
+  uint64_t shadow;   // float per pixel (df_shadow.comp), or 0: no shadows
   uint width;
   uint height;
 };
@@ -266,8 +273,8 @@ SHADER_NAMESPACE_END
 static_assert(sizeof(fibscope::shader::TileClassifyPush) == 32, "");
 static_assert(sizeof(fibscope::shader::SsaoPush) == 64, "");
 static_assert(sizeof(fibscope::shader::SsaoBlurPush) == 64, "");
-static_assert(sizeof(fibscope::shader::ShadePush) == 64, "");
-static_assert(offsetof(fibscope::shader::ShadePush, width) == 56, "scalars follow the seven addresses");
+static_assert(sizeof(fibscope::shader::ShadePush) == 72, "");
+static_assert(offsetof(fibscope::shader::ShadePush, width) == 64, "scalars follow the eight addresses");
 static_assert(offsetof(fibscope::shader::ShadeBlock, solid) == 16, "");
 static_assert(offsetof(fibscope::shader::ShadeBlock, roughness) == 60, "");
 static_assert(offsetof(fibscope::shader::ShadeBlock, colormap) == 80, "");

@@ -100,7 +100,8 @@ SVO_CONST uint kSvoTraceTile = 8u;           // 8 x 8 pixels per workgroup
 // svo_voxelize.comp: workgroup g takes segment g; its invocations walk the
 // voxels of the segment's box (widened by r + band) inside the slab
 // z in [slab_z0, slab_z0 + slab_depth) and atomicMin svoOrderedKey(f_s) into
-// field[(z - slab_z0) * side^2 + y * side + x] where f_s < band.
+// field[((z - slab_z0) * rows + y) * side + x] where f_s < band (rows =
+// side unless given).
 struct SvoVoxelizePush {
   uint64_t nodes;     // TubeNode[]
   uint64_t segments;  // TubeSegment[]
@@ -113,7 +114,10 @@ struct SvoVoxelizePush {
   uint segment_count;
   float band;
   uint curved;  // 1: curved tubes (glsl/svo_curve.glsl), 0: capsules
-  uint pad1;
+  // The field's y extent when it is not `side` (the distance field of
+  // shared/distance_field.h: side x rows x slab_depth voxels, rows the y
+  // stride); 0: side. z is bounded by the slab alone.
+  uint rows;
   uint pad2;
 };
 

@@ -24,6 +24,7 @@
 #include "render/camera.h"
 #include "render/gpu/frame_renderer.h"
 #include "render/gpu/frame_stages.h"
+#include "svo/gpu/gpu_distance_field.h"
 #include "svo/gpu/gpu_svo.h"
 #include "tubes/gpu/gpu_tubes.h"
 
@@ -110,17 +111,24 @@ void runRender(RenderCommandOptions o) {
   // below, released by `tubes_owner` before the device goes).
   GpuTubes tubes;
   GpuSvo svo_tree;
+  // The tubes' distance field (--ao-method df, --df-shadows): built with
+  // the tubes, read by the distance-field stage.
+  GpuDistanceField distance_field;
+  const bool wants_field =
+      (svo || o.tubes.requested()) && (distanceFieldAoRuns(settings) || distanceFieldShadowsRun(settings));
   struct Device {
     std::unique_ptr<gpu::VulkanContext> context;
     std::unique_ptr<FrameRenderer> renderer;  // destroyed before the context
   };
-  std::future<Device> making = std::async(std::launch::async, [&o, &settings, &tubes, &svo_tree, svo, width, height] {
+  std::future<Device> making = std::async(std::launch::async, [&o, &settings, &tubes, &svo_tree, &distance_field,
+                                                               svo, wants_field, width, height] {
     Device d;
     d.context = createRenderContext(o.render);
-    d.renderer = std::make_unique<FrameRenderer>(
-        *d.context, width, height,
+    FrameStageList stages =
         svo ? withSvoStage(standardFrameStages(), &svo_tree, &tubes)
-            : (o.tubes.requested() ? withTubeStage(standardFrameStages(), &tubes) : standardFrameStages()));
+            : (o.tubes.requested() ? withTubeStage(standardFrameStages(), &tubes) : standardFrameStages());
+    if (wants_field) stages = withDistanceFieldStage(std::move(stages), &distance_field);
+    d.renderer = std::make_unique<FrameRenderer>(*d.context, width, height, std::move(stages));
     d.renderer->prepare(settings);  // this frame's shader variants
     return d;
   });
@@ -144,13 +152,15 @@ void runRender(RenderCommandOptions o) {
     const gpu::VulkanContext& context;
     GpuTubes& tubes;
     GpuSvo& svo;
+    GpuDistanceField& field;
     gpu::Buffer& selection;
     ~TubesOwner() {
       gpu::destroyBuffer(context, selection);
+      destroyDistanceField(context, field);
       destroySvo(context, svo);
       destroyTubes(context, tubes);
     }
-  } tubes_owner{context, tubes, svo_tree, tube_selection};
+  } tubes_owner{context, tubes, svo_tree, distance_field, tube_selection};
   GpuScene gpu_scene = scene.gpuScene();
   applyScalarColoring(context, scene.fiblets, o.render, settings, gpu_scene);
   const SceneFilter filter(context, scene, criteria, o.render.dim_dropped);
@@ -175,6 +185,7 @@ void runRender(RenderCommandOptions o) {
       svo_tree = uploadSvo(context, tree);
       svo_line = svoBuildSummary(model, tree, svo_stats);
     }
+    if (wants_field) distance_field = buildDistanceFieldGpu(context, tubes, chooseDistanceFieldGrid(model, settings.df_voxel_mm));
     if (o.tubes.dim_rest && !o.render.dim_dropped) {
       tube_words.assign((scene.streamlines + 31) / 32, 0u);
       for (const TubeModel::Tube& t : model.tubes)
@@ -230,6 +241,18 @@ void runRender(RenderCommandOptions o) {
     if (settings.tube_method == TubeMethod::Compute)
       std::printf(", %llu tiles overflowed", static_cast<unsigned long long>(stats.tube_tiles_overflowed));
     std::printf("\n");
+  }
+  if (wants_field) {
+    double ao_ms = 0, shadow_ms = 0;
+    for (const PassTiming& p : stats.passes) {
+      if (p.name == "df ao") ao_ms += p.ms;
+      if (p.name == "df shadow") shadow_ms += p.ms;
+    }
+    const DistanceFieldGrid& g = distance_field.grid;
+    std::printf("distance field: voxel %.3f mm, %ux%ux%u (%.1f MB), band %.2f mm, built in %.3f s; df ao %.2f ms, "
+                "df shadow %.2f ms\n",
+                g.voxel, g.size.x, g.size.y, g.size.z, double(g.bytes()) / 1e6, g.band, distance_field.build_s, ao_ms,
+                shadow_ms);
   }
   if (filter.active())
     std::printf("filter: %llu of %llu fibers kept (%s), %.2f ms on the GPU\n",

@@ -42,6 +42,7 @@ constexpr std::pair<std::string_view, Colormap> kColormaps[] = {{"viridis", Colo
                                                                 {"coolwarm", Colormap::CoolWarm}};
 constexpr std::pair<std::string_view, TubeMethod> kTubeMethods[] = {
     {"compute", TubeMethod::Compute}, {"raycast", TubeMethod::Raycast}, {"tess", TubeMethod::Tessellation}};
+constexpr std::pair<std::string_view, AoMethod> kAoMethods[] = {{"ssao", AoMethod::Ssao}, {"df", AoMethod::Df}};
 
 constexpr std::pair<std::string_view, SliceSampling> kSamplings[] = {{"trilinear", SliceSampling::Trilinear},
                                                                    {"nearest", SliceSampling::Nearest}};
@@ -65,6 +66,8 @@ Lighting parseLighting(std::string_view name) { return parseName("lighting", nam
 Colormap parseColormap(std::string_view name) { return parseName("colormap", name, kColormaps); }
 TubeMethod parseTubeMethod(std::string_view name) { return parseName("tube-method", name, kTubeMethods); }
 std::string_view tubeMethodName(TubeMethod method) { return nameOf(method, kTubeMethods); }
+AoMethod parseAoMethod(std::string_view name) { return parseName("ao-method", name, kAoMethods); }
+std::string_view aoMethodName(AoMethod method) { return nameOf(method, kAoMethods); }
 std::string_view sliceSamplingName(SliceSampling sampling) { return nameOf(sampling, kSamplings); }
 std::string_view sliceAxisName(SliceAxis axis) { return nameOf(axis, kSliceAxes); }
 std::string_view renderPipelineName(RenderPipeline pipeline) { return nameOf(pipeline, kPipelines); }

@@ -83,6 +83,16 @@ enum class TubeMethod : uint8_t {
   Tessellation,  // adaptively tessellated cylinders (seed 3.1)
 };
 
+// Which pass writes the ambient-occlusion factor the shade pass multiplies
+// by (when RenderSettings::ssao is on).
+enum class AoMethod : uint8_t {
+  Ssao,  // screen-space (shaders/ssao.comp)
+  // Evans' distance-field AO from the tubes' dense distance field
+  // (shaders/df_ao.comp; McGraw's seed, issue 16 item 4): only frames that
+  // have one (tubes or the svo pipelines in `render`); elsewhere no AO.
+  Df,
+};
+
 enum class Lighting : uint8_t {
   None,
   IlluminatedLines,  // Zoeckler / Stalling / Hege: diffuse and specular from the tangent alone
@@ -143,6 +153,20 @@ struct RenderSettings {
   // the blur make them 256 directions.
   int ao_scales = 1;
   int ao_samples = 16;
+  AoMethod ao_method = AoMethod::Ssao;
+  // The tubes' distance field (shaders/shared/distance_field.h): its voxel
+  // (0: the largest tube radius, coarsened until the field is at most 64
+  // MB), read when the field is built (once per tube model). Evans' AO:
+  // df_ao_steps samples N at heights 0.5 voxel + i delta along the normal
+  // (delta = df_ao_delta_mm, 0: the field's voxel), strength k per delta.
+  // Soft shadows from the headlight by sphere tracing the field, penumbra
+  // softness k_s (larger: harder edges).
+  float df_voxel_mm = 0.0f;
+  int df_ao_steps = 5;
+  float df_ao_delta_mm = 0.0f;
+  float df_ao_strength = 1.0f;
+  bool df_shadows = false;
+  float df_shadow_softness = 8.0f;
   // FXAA (Lottes' fast approximate anti-aliasing, 3.11 quality-like) over
   // the shaded RGBA8 image: smooths the stair steps of 1-pixel lines.
   bool fxaa = false;
@@ -212,12 +236,14 @@ ColorMode parseColorMode(std::string_view name);
 Lighting parseLighting(std::string_view name);
 Colormap parseColormap(std::string_view name);
 TubeMethod parseTubeMethod(std::string_view name);
+AoMethod parseAoMethod(std::string_view name);
 std::string_view renderPipelineName(RenderPipeline pipeline);
 std::string_view cullingModeName(CullingMode mode);
 std::string_view colorModeName(ColorMode mode);
 std::string_view lightingName(Lighting lighting);
 std::string_view colormapName(Colormap colormap);
 std::string_view tubeMethodName(TubeMethod method);  // "compute", "raycast", "tess"
+std::string_view aoMethodName(AoMethod method);      // "ssao", "df"
 std::string_view sliceSamplingName(SliceSampling sampling);
 std::string_view sliceAxisName(SliceAxis axis);
 

@@ -8,6 +8,7 @@
 #include "core/error.h"
 #include "render/colormap.h"
 #include "render/reference_raster.h"
+#include "shared/distance_field.h"
 #include "shared/shade_push.h"
 
 namespace fibscope {
@@ -97,7 +98,10 @@ bool isScalar(const RenderSettings& s) { return s.color == ColorMode::Scalar; }
 bool isLit(const RenderSettings& s) { return s.lighting == Lighting::IlluminatedLines; }
 bool isPbr(const RenderSettings& s) { return s.lighting == Lighting::Pbr; }
 bool hasAmbient(const RenderSettings& s) { return s.lighting != Lighting::None; }
-bool hasSsao(const RenderSettings& s) { return s.ssao; }
+bool hasSsao(const RenderSettings& s) { return s.ssao && s.ao_method == AoMethod::Ssao; }
+bool hasAo(const RenderSettings& s) { return s.ssao; }
+bool hasDfAo(const RenderSettings& s) { return s.ssao && s.ao_method == AoMethod::Df; }
+bool hasDfShadows(const RenderSettings& s) { return s.df_shadows; }
 bool isTessellatedTubes(const RenderSettings& s) { return s.tube_method == TubeMethod::Tessellation; }
 
 std::vector<SettingInfo> makeTable() {
@@ -174,7 +178,14 @@ std::vector<SettingInfo> makeTable() {
   t.push_back(with(number("light-intensity", "light intensity", "PBR: total radiance of the ring of lights",
                           &RenderSettings::pbr_intensity, 0, 64),
                    isPbr));
-  t.push_back(flag("ssao", "ambient occlusion", "Screen-space ambient occlusion", &RenderSettings::ssao));
+  t.push_back(flag("ssao", "ambient occlusion", "Ambient occlusion (by --ao-method)", &RenderSettings::ssao));
+  t.push_back(with(choice("ao-method", "AO method",
+                          "ssao (screen space) | df (Evans' distance-field AO from the tubes' distance field: "
+                          "frames with tubes or an svo pipeline)",
+                          2, [](int v) { return aoMethodName(AoMethod(v)); },
+                          getChoice<AoMethod, &RenderSettings::ao_method>,
+                          setChoice<AoMethod, &RenderSettings::ao_method>),
+                   hasAo));
   t.push_back(with(number("ssao-radius", "AO radius", "SSAO sampling radius in pixels (the smallest scale)",
                           &RenderSettings::ssao_radius_px, 1, 64, "px"),
                    hasSsao));
@@ -201,6 +212,31 @@ std::vector<SettingInfo> makeTable() {
                           "Neighbours nearer than this (view distance) no longer occlude, in mm",
                           &RenderSettings::ssao_range_mm, 0.5, 200, "mm"),
                    hasSsao));
+  // The tubes' distance field (shared/distance_field.h): AO and shadows.
+  t.push_back(number("df-voxel", "DF voxel",
+                     "Voxel of the tubes' distance field (AO and shadows), mm; 0: the largest tube radius, "
+                     "coarsened until the field is at most 64 MB (read when the field is built)",
+                     &RenderSettings::df_voxel_mm, 0, 100, "mm"));
+  t.push_back(with(integer("df-ao-steps", "DF AO steps", "Distance-field AO: samples N along the normal",
+                           &RenderSettings::df_ao_steps, 1, shader::kDfMaxAoSteps),
+                   hasDfAo));
+  t.push_back(with(number("df-ao-delta", "DF AO step",
+                          "Distance-field AO: spacing delta of the samples, mm (0: the field's voxel; the reach "
+                          "N delta is capped at 8 voxels)",
+                          &RenderSettings::df_ao_delta_mm, 0, 100, "mm"),
+                   hasDfAo));
+  t.push_back(with(number("df-ao-strength", "DF AO strength",
+                          "Distance-field AO: k in 1 - (k / delta) sum 2^-i (h_i - d_i)", &RenderSettings::df_ao_strength,
+                          0, 8),
+                   hasDfAo));
+  t.push_back(flag("df-shadows", "DF shadows",
+                   "Soft shadows from the headlight, sphere-traced through the tubes' distance field (frames with "
+                   "tubes or an svo pipeline)",
+                   &RenderSettings::df_shadows));
+  t.push_back(with(number("df-shadow-softness", "shadow hardness",
+                          "Soft shadows: k_s in min(k_s d / t) (larger: harder penumbrae)",
+                          &RenderSettings::df_shadow_softness, 0.5, 128),
+                   hasDfShadows));
   // Post effects, in the order they apply (after AO, before FXAA).
   SettingInfo flatten = entry("flatten", "flatten",
                               "Colour flattening to N levels a channel (2 to 256; 0 or 1: off)", SettingKind::Integer);

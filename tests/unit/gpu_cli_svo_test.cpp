@@ -73,6 +73,30 @@ TEST_F(GpuCliSvo, renderDrawsThePhantomAsCurvedOctreeTubes) {
   EXPECT_EQ(d.exit_code, 2) << d.output;
 }
 
+// --ao-method df --df-shadows (issue 16 item 4): the tubes' distance field
+// is built and reported with its passes' times, and the picture differs
+// from SSAO's.
+TEST_F(GpuCliSvo, renderShadesTheTubesWithDistanceFieldAoAndShadows) {
+  const std::string common = "render --validate --phantom-streamlines 20 --size 96x72 --view axial --pipeline "
+                             "svo-straight --tube-radius 2.0 --tube-tolerance 0.05 -o ";
+  const std::string ssao = dir_.file("ssao.png"), df = dir_.file("df.png");
+  const auto a = runFibscope(common + ssao);
+  ASSERT_EQ(a.exit_code, 0) << a.output;
+  EXPECT_EQ(a.output.find("distance field:"), std::string::npos) << a.output;
+  const auto b = runFibscope(common + df + " --ao-method df --df-shadows");
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  EXPECT_NE(b.output.find("distance field: voxel"), std::string::npos) << b.output;
+  EXPECT_NE(b.output.find("df shadow"), std::string::npos) << b.output;
+  const test::Png pa = test::readOurPng(ssao), pb = test::readOurPng(df);
+  ASSERT_EQ(pa.rgba.size(), pb.rgba.size());
+  size_t changed = 0;
+  for (size_t i = 0; i < pa.rgba.size(); i += 4)
+    changed += pa.rgba[i] != pb.rgba[i] || pa.rgba[i + 1] != pb.rgba[i + 1] || pa.rgba[i + 2] != pb.rgba[i + 2];
+  EXPECT_GT(changed, 100u) << changed;
+  const auto c = runFibscope(common + dir_.file("x.png") + " --ao-method fancy");
+  EXPECT_EQ(c.exit_code, 2) << c.output;
+}
+
 TEST_F(GpuCliSvo, badRadiusOrVoxelIsOneLineAndExitCode2) {
   const std::string common = "render --phantom-streamlines 10 --size 32x32 --pipeline svo-straight -o " + dir_.file("x.png");
   for (const std::string& bad : {std::string(" --tube-radius 0"), std::string(" --tube-radius -1"),

@@ -55,6 +55,12 @@ struct FrameContext {
   // A surface stage runs this frame: the surface target exists, is cleared
   // by the setup stage and merged into the G-buffer by the merge stage.
   bool surfaces = false;
+  // Set by the distance-field stage (src/svo/gpu/gpu_distance_field.h)
+  // when it wrote this frame's AO factor into targets.ao (in place of
+  // SSAO) and its shadow factor into targets.ao_blur (SSAO's scratch,
+  // unused then): the shade pass reads them.
+  bool df_ao = false;
+  bool df_shadow = false;
 };
 
 class FrameStage {

@@ -98,7 +98,8 @@ class ShadeStage final : public FrameStage {
     push.camera = t.camera.address;
     push.gbuffer = t.gbuffer.address;
     push.surface = frame.surfaces ? t.surface.address : 0;
-    push.ao = ssaoRuns(s) ? t.ao.address : 0;
+    push.ao = ssaoRuns(s) || frame.df_ao ? t.ao.address : 0;
+    push.shadow = frame.df_shadow ? t.ao_blur.address : 0;
     push.color = (shadeTarget(s) == ShadeTarget::Shaded ? t.shaded : t.color).address;
     push.tiles = t.tile_list.address;
     push.block = block_.address;

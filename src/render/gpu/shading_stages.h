@@ -27,7 +27,8 @@
 
 namespace fibscope {
 
-// Whether the SSAO passes run (and shade multiplies by their factor).
+// Whether the SSAO passes run (and shade multiplies by their factor):
+// ambient occlusion on, by the screen-space method.
 bool ssaoRuns(const RenderSettings& settings);
 
 inline bool fxaaRuns(const RenderSettings& settings) { return settings.fxaa; }

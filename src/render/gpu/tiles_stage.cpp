@@ -80,7 +80,9 @@ uint32_t packRgba8(const std::array<float, 3>& c) {
   return packed;
 }
 
-bool ssaoRuns(const RenderSettings& s) { return s.ssao && s.ssao_radius_px > 0.0f && s.ssao_strength > 0.0f; }
+bool ssaoRuns(const RenderSettings& s) {
+  return s.ssao && s.ao_method == AoMethod::Ssao && s.ssao_radius_px > 0.0f && s.ssao_strength > 0.0f;
+}
 
 std::unique_ptr<FrameStage> makeTilesStage(const gpu::VulkanContext& context) {
   return std::make_unique<TilesStage>(context);

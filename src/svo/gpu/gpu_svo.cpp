@@ -131,6 +131,20 @@ void gpuRadixSort(const gpu::VulkanContext& context, std::vector<uint32_t>& keys
   gpu::downloadFromBuffer(context, v, values.data(), bytes);
 }
 
+gpu::ComputePipeline createSvoVoxelizePipeline(const gpu::VulkanContext& context) {
+  return gpu::createComputePipeline(context, "svo_voxelize.comp", sizeof(shader::SvoVoxelizePush),
+                                    gpu::WorkgroupSize{shader::kSvoVoxelizeGroupSize});
+}
+
+void recordSvoVoxelize(const gpu::VulkanContext& context, VkCommandBuffer cmd, const gpu::ComputePipeline& voxelize,
+                       const GpuTubes& tubes, shader::SvoVoxelizePush push) {
+  push.nodes = tubes.nodes.address;
+  push.segments = tubes.segments.address;
+  push.segment_count = tubes.segment_count;
+  const gpu::DispatchGrid g = gpu::dispatchGrid(context, tubes.segment_count);
+  gpu::recordDispatch(cmd, voxelize, push, g.x, g.y);
+}
+
 std::vector<SvoLeaf> voxelizeSvoLeavesGpu(const gpu::VulkanContext& context, const TubeModel& model,
                                           const GpuTubes& tubes, const SvoGrid& grid,
                                           const SvoGpuBuildOptions& options, SvoGpuBuildStats* stats) {
@@ -162,8 +176,7 @@ std::vector<SvoLeaf> voxelizeSvoLeavesGpu(const gpu::VulkanContext& context, con
       gpu::destroyComputePipeline(c, a);
     }
   } pipes{context, voxelize, compact};
-  voxelize = gpu::createComputePipeline(context, "svo_voxelize.comp", sizeof(shader::SvoVoxelizePush),
-                                        gpu::WorkgroupSize{shader::kSvoVoxelizeGroupSize});
+  voxelize = createSvoVoxelizePipeline(context);
   compact = gpu::createComputePipeline(context, "svo_compact.comp", sizeof(shader::SvoCompactPush),
                                        gpu::WorkgroupSize{shader::kSvoCompactGroupSize});
   radix = std::make_unique<RadixPipelines>(context);
@@ -189,8 +202,6 @@ std::vector<SvoLeaf> voxelizeSvoLeavesGpu(const gpu::VulkanContext& context, con
         vkCmdFillBuffer(cmd, field.buffer, 0, VK_WHOLE_SIZE, shader::kSvoFar);
         gpu::recordBarrier(cmd, gpu::kTransferToCompute);
         shader::SvoVoxelizePush vp{};
-        vp.nodes = tubes.nodes.address;
-        vp.segments = tubes.segments.address;
         vp.field = field.address;
         vp.origin_x = grid.origin.x;
         vp.origin_y = grid.origin.y;
@@ -199,11 +210,9 @@ std::vector<SvoLeaf> voxelizeSvoLeavesGpu(const gpu::VulkanContext& context, con
         vp.side = uint32_t(side);
         vp.slab_z0 = z0;
         vp.slab_depth = depth;
-        vp.segment_count = tubes.segment_count;
         vp.band = grid.band();
         vp.curved = grid.curved ? 1u : 0u;
-        const gpu::DispatchGrid g = gpu::dispatchGrid(context, tubes.segment_count);
-        gpu::recordDispatch(cmd, voxelize, vp, g.x, g.y);
+        recordSvoVoxelize(context, cmd, voxelize, tubes, vp);
         gpu::computeToComputeBarrier(cmd);
         shader::SvoCompactPush cp{};
         cp.field = field.address;

@@ -11,8 +11,10 @@
 #include <vector>
 
 #include "gpu/buffer.h"
+#include "gpu/compute_pipeline.h"
 #include "gpu/vulkan_context.h"
 #include "render/gpu/frame_stage.h"
+#include "shared/svo.h"
 #include "svo/svo_build.h"
 #include "tubes/gpu/gpu_tubes.h"
 
@@ -24,6 +26,15 @@ namespace fibscope {
 // memory runs out.
 void gpuRadixSort(const gpu::VulkanContext& context, std::vector<uint32_t>& keys, std::vector<uint32_t>& values,
                   uint32_t bits = 32);
+
+// svo_voxelize.comp, and its dispatch over every segment of `tubes` with
+// `push`'s field, grid, slab and band (the tube addresses and the segment
+// count filled in here): the octree's voxelisation and the distance field's
+// (gpu_distance_field.h) record it alike. The field must hold kSvoFar
+// before and be visible to compute writes.
+gpu::ComputePipeline createSvoVoxelizePipeline(const gpu::VulkanContext& context);
+void recordSvoVoxelize(const gpu::VulkanContext& context, VkCommandBuffer cmd, const gpu::ComputePipeline& voxelize,
+                       const GpuTubes& tubes, shader::SvoVoxelizePush push);
 
 struct SvoGpuBuildOptions {
   uint64_t field_budget_bytes = 64ull << 20;  // the dense slab's size at most (decides the slab depth)
