@@ -1,0 +1,390 @@
+// The tessellated spline tubes (tube_tess_stage.h: tube_tess.vert / .tesc /
+// .tese / .frag) against the CPU reference of the ray-cast tubes
+// (src/tubes/tube_intersect.h, the seed's sphere-swept model) on the same
+// tube model: coverage and fiber ids agree, silhouettes within a pixel,
+// depths within the tessellation's own error (derived below from the
+// geometry: faceting, ring spacing, the model difference); rings do not
+// twist on sharp turns and a helix; back-patch culling changes no texel;
+// tubes and lines occlude each other both ways; a one-point tube is a
+// sphere; an empty model draws nothing. Validation layers on; frames
+// <= 128 x 96. FIBSCOPE_TUBE_TESS_PNG=DIR writes the images' normals as
+// PNGs to DIR for a look.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include <glm/geometric.hpp>
+
+#include "gpu_render_test_support.h"
+#include "gpu_test_context.h"
+#include "io/png_writer.h"
+#include "render/gpu/frame_renderer.h"
+#include "render/gpu/frame_stages.h"
+#include "render/gpu/raw_tractogram.h"
+#include "render/gpu/tractogram_upload.h"
+#include "render/image_compare.h"
+#include "render/reference_raster.h"
+#include "shared/gbuffer.h"
+#include "tube_test_scenes.h"
+#include "tubes/gpu/gpu_tubes.h"
+#include "tubes/gpu/tube_tess_stage.h"
+#include "tubes/tube_intersect.h"
+
+namespace fibscope {
+namespace {
+
+class GpuTubeTess : public test::GpuTest {
+ protected:
+  void SetUp() override {
+    test::GpuTest::SetUp();
+    if (!context().enabledFeatures().tessellationShader || !context().info().queue_has_graphics)
+      GTEST_SKIP() << "the device has no tessellation shaders or no graphics queue";
+  }
+  // The surface target of one frame of `model` (setup and the tessellation
+  // stage only).
+  std::vector<shader::SurfaceTexel> draw(const TubeModel& model, const Camera& camera, TubeTessOptions options = {},
+                                         FrameStats* stats = nullptr, RenderSettings settings = {}) {
+    GpuTubes tubes = uploadTubes(context(), model);
+    std::vector<shader::SurfaceTexel> surface;
+    try {
+      FrameRenderer renderer(context(), camera.width, camera.height,
+                             {makeSetupStage, tubeTessellationStage(&tubes, options)});
+      const FrameStats frame = renderer.render(camera, settings, GpuScene());
+      if (stats) *stats = frame;
+      surface = downloadSurface(context(), renderer.targets());
+    } catch (...) {
+      destroyTubes(context(), tubes);
+      throw;
+    }
+    destroyTubes(context(), tubes);
+    return surface;
+  }
+};
+
+void maybeWritePng(const std::string& name, const std::vector<shader::SurfaceTexel>& s, const Camera& camera) {
+  const char* dir = std::getenv("FIBSCOPE_TUBE_TESS_PNG");
+  if (!dir) return;
+  std::vector<uint8_t> rgba;
+  for (const shader::SurfaceTexel& t : s) {
+    const std::array<float, 3> n = test::unpackTangent(t.normal);
+    const bool hit = t.depth < 1.0f;
+    for (int k = 0; k < 3; ++k) rgba.push_back(hit ? uint8_t(std::lround(127.5f + 127.5f * n[k])) : 0);
+    rgba.push_back(255);
+  }
+  std::string file = name;
+  for (char& c : file)
+    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+  writePngRgba(std::string(dir) + "/" + file + ".png", camera.width, camera.height, rgba);
+}
+
+// How far the tessellated surface may lie from the reference's along a
+// surface normal (mm), from the model's geometry:
+//  - faceting: the chord of an arc of 2 pi / vertices (no refinement)
+//    lies r (1 - cos(pi / vertices)) inside the circle;
+//  - ring spacing: the chord between rings, ds = chord / rings, lies
+//    ds_outer^2 / (8 (rho + r)) inside the outer side of a bend of centre
+//    radius rho (ds_outer = ds (rho + r) / rho), rho from the nodes'
+//    turning per mm;
+//  - the models: the reference sweeps spheres along two quadratics per
+//    Hermite segment (its end spheres included), the tessellation puts
+//    circles normal to the Hermite curve itself: the largest distance of a
+//    Hermite point to the quadratic pair (sampled), and the sphere-swept
+//    radius r / sqrt(1 - r'^2) against r.
+double surfaceTolerance(const TubeModel& model, int rings, int vertices) {
+  double facet = 0, along = 0, curve = 0, swept = 0;
+  for (const shader::TubeSegment& s : model.segments) {
+    const shader::TubeNode &a = model.nodes[s.node], &b = model.nodes[s.node + 1];
+    const double r = std::max(a.position_radius.w, b.position_radius.w);
+    facet = std::max(facet, r * (1.0 - std::cos(std::numbers::pi / vertices)));
+    const glm::vec3 ta(a.tangent_dradius.x, a.tangent_dradius.y, a.tangent_dradius.z);
+    const glm::vec3 tb(b.tangent_dradius.x, b.tangent_dradius.y, b.tangent_dradius.z);
+    if (s.chord > 0) {
+      const double turn = std::acos(std::clamp(double(glm::dot(ta, tb)), -1.0, 1.0));
+      const double rho = turn > 1e-6 ? s.chord / turn : 1e30;
+      const double ds = s.chord / rings * (rho + r) / rho;
+      along = std::max(along, ds * ds / (8.0 * (rho + r)));
+      for (int k = 0; k <= 64; ++k) {
+        const glm::vec3 h = tubeSegmentPoint(model, s, float(k) / 64.0f);
+        double best = 1e30;
+        for (uint32_t half = 0; half < 2; ++half) {
+          const shader::TubeQuadratic q = tubeSubSegment(model, uint32_t(2 * (&s - model.segments.data())) + half);
+          for (int j = 0; j <= 256; ++j)
+            best = std::min(best, glm::distance(glm::dvec3(h), tubeQuadraticCenter(q, j / 256.0)));
+        }
+        curve = std::max(curve, best);
+      }
+    }
+    const double slope = std::max(std::fabs(a.tangent_dradius.w), std::fabs(b.tangent_dradius.w));
+    if (slope < 1) swept = std::max(swept, r * (1.0 / std::sqrt(1.0 - slope * slope) - 1.0));
+  }
+  return facet + along + curve + swept;
+}
+
+struct Agreement {
+  CoverageComparison coverage;
+  size_t both = 0, fiber_mismatch = 0, facing = 0;
+  double max_depth_mm = 0, max_normal_error = 0, max_position_error = 0;
+  std::string summary() const {
+    return coverage.summary() + "; " + std::to_string(both) + " both, " + std::to_string(fiber_mismatch) +
+           " fibers differ, depth error " + std::to_string(max_depth_mm) + " mm on " + std::to_string(facing) +
+           " facing pixels, normal " + std::to_string(max_normal_error) + ", position " +
+           std::to_string(max_position_error);
+  }
+};
+
+// Depth is compared where the reference surface faces the eye (|cos| >=
+// 1/2 between its normal and the ray): there a surface within e along its
+// normal is within e / |cos| along the ray; at grazing pixels a faceted
+// silhouette moves the hit along the ray without bound, which the
+// coverage comparison measures instead.
+Agreement compareWithReference(const std::vector<shader::SurfaceTexel>& gpu, const TubeReferenceImage& ref,
+                               const Camera& camera) {
+  const std::array<double, 16> view = viewMatrixD(camera);
+  const glm::dvec3 forward(-view[2], -view[6], -view[10]);
+  const double n = camera.near_mm, f = camera.far_mm;
+  Agreement a;
+  std::vector<uint8_t> got(gpu.size()), want(gpu.size());
+  for (size_t i = 0; i < gpu.size(); ++i) {
+    got[i] = gpu[i].depth < 1.0f;
+    want[i] = ref.fiber[i] != shader::kNoFiberId;
+    if (!got[i] || !want[i]) continue;
+    ++a.both;
+    if (gpu[i].fiber != ref.fiber[i]) ++a.fiber_mismatch;
+    EXPECT_EQ(gpu[i].source, shader::kSurfaceSourceTube);
+    const uint32_t px = uint32_t(i % camera.width), py = uint32_t(i / camera.width);
+    glm::dvec3 o, d;
+    tubePixelRay(camera, px, py, o, d);
+    const std::array<float, 3> g = test::unpackTangent(gpu[i].normal);
+    a.max_normal_error =
+        std::max(a.max_normal_error, double(glm::distance(glm::vec3(g[0], g[1], g[2]), ref.normal[i])));
+    a.max_position_error = std::max(a.max_position_error, double(std::fabs(gpu[i].position - ref.position[i])));
+    const double cosine = std::fabs(glm::dot(glm::dvec3(ref.normal[i]), d));
+    if (cosine < 0.5) continue;
+    ++a.facing;
+    const double z_gpu = n * f / (f - double(gpu[i].depth) * (f - n));
+    const double z_ref = ref.distance[i] * glm::dot(d, forward);
+    a.max_depth_mm = std::max(a.max_depth_mm, std::fabs(z_gpu - z_ref) * cosine);  // along the normal
+  }
+  a.coverage = compareCoverage(got, want, camera.width, camera.height);
+  return a;
+}
+
+std::string cameraName(const Camera& camera) {
+  return "from (" + std::to_string(camera.eye[0]) + ", " + std::to_string(camera.eye[1]) + ", " +
+         std::to_string(camera.eye[2]) + ")";
+}
+
+// The default tessellation against the reference: >= 98 % coverage
+// agreement, silhouettes within a pixel, the same fibers, depth within the
+// surface tolerance, normals within the facets' angle.
+void expectMatchesReference(const Agreement& a, double tolerance_mm, int vertices, const std::string& what) {
+  EXPECT_GT(a.both, 250u) << what;
+  EXPECT_GE(a.coverage.agreement, 0.98) << what;
+  EXPECT_LE(a.coverage.maxDistance(), 1.0) << what;
+  EXPECT_EQ(a.fiber_mismatch, 0u) << what;
+  EXPECT_LE(a.max_depth_mm, tolerance_mm) << what << " (tolerance " << tolerance_mm << " mm)";
+  // An interpolated normal is off by less than a facet's angle.
+  EXPECT_LE(a.max_normal_error, 2.0 * std::sin(std::numbers::pi / vertices)) << what;
+}
+
+TEST_F(GpuTubeTess, tessellatedTubesMatchTheRayCastReferenceOnCurvedTubes) {
+  const RenderSettings defaults;
+  for (const test::TubeScene& scene : test::tubeScenes()) {
+    const TubeModel model = buildTubes(scene.tractogram, scene.options);
+    const double tolerance = surfaceTolerance(model, defaults.tube_rings, defaults.tube_vertices);
+    for (const Camera& camera : test::tubeSceneCameras(scene, 120, 90)) {
+      const TubeReferenceImage ref = renderReferenceTubes(model, camera, TubeReferenceMethod::Cascade);
+      FrameStats stats;
+      const std::vector<shader::SurfaceTexel> got = draw(model, camera, {}, &stats);
+      maybeWritePng("tess " + scene.name + " " + cameraName(camera), got, camera);
+      const Agreement a = compareWithReference(got, ref, camera);
+      const std::string what = scene.name + " " + cameraName(camera) + ": " + a.summary();
+      expectMatchesReference(a, tolerance, defaults.tube_vertices, what);
+      EXPECT_LE(a.max_position_error, 0.05) << what;
+      bool timed_keys = false, timed_texels = false;
+      for (const PassTiming& p : stats.passes) {
+        timed_keys |= p.name == "tube tess";
+        timed_texels |= p.name == "tube tess texels";
+        EXPECT_TRUE(isTubePass(p.name) || p.name.rfind("tube", 0) != 0) << p.name;
+      }
+      EXPECT_TRUE(timed_keys && timed_texels);
+    }
+  }
+}
+
+// Rings that twisted between nodes would pinch the tube (its cross-section
+// a collapsed circle where the frame turns about the tangent): a helix of
+// tight pitch and a 90-degree corner taken within two segments, both
+// against the reference with the same tolerances.
+TEST_F(GpuTubeTess, ringsDoNotTwistOnAHelixOrASharpCorner) {
+  Tractogram t;
+  std::vector<float> helix, corner;
+  for (int i = 0; i <= 24; ++i) {
+    const float a = float(i) * std::numbers::pi_v<float> / 6.0f;  // 30 degrees a point
+    helix.insert(helix.end(), {2.0f * std::cos(a), 2.0f * std::sin(a), 0.25f * a - 3.0f});
+  }
+  for (int i = 0; i <= 4; ++i) corner.insert(corner.end(), {-7.0f + float(i), -4.0f, 1.0f});
+  for (int i = 1; i <= 4; ++i) corner.insert(corner.end(), {-3.0f, -4.0f + float(i), 1.0f});
+  t.addStreamline(helix.data(), helix.size() / 3);
+  t.addStreamline(corner.data(), corner.size() / 3);
+  TubeBuildOptions o;
+  o.radius.radius = 0.45f;
+  const TubeModel model = buildTubes(t, o);
+  const RenderSettings defaults;
+  const double tolerance = surfaceTolerance(model, defaults.tube_rings, defaults.tube_vertices);
+  Bounds b = tractogramBounds(t);
+  for (int k = 0; k < 3; ++k) {
+    b.min[k] -= 0.45f;
+    b.max[k] += 0.45f;
+  }
+  for (const Camera& camera : {fitCamera(b, {0, 0, 1}, {0, 1, 0}, 128, 96), fitCamera(b, {1, -0.5, 0.3}, {0, 0, 1}, 128, 96)}) {
+    const std::vector<shader::SurfaceTexel> got = draw(model, camera);
+    maybeWritePng("tess helix " + cameraName(camera), got, camera);
+    const Agreement a =
+        compareWithReference(got, renderReferenceTubes(model, camera, TubeReferenceMethod::Cascade), camera);
+    expectMatchesReference(a, tolerance, defaults.tube_vertices, "helix and corner " + cameraName(camera) + ": " + a.summary());
+  }
+}
+
+TEST_F(GpuTubeTess, backPatchCullingChangesNoTexel) {
+  for (const test::TubeScene& scene : test::tubeScenes()) {
+    const TubeModel model = buildTubes(scene.tractogram, scene.options);
+    for (const Camera& camera : test::tubeSceneCameras(scene, 96, 72)) {
+      const std::vector<shader::SurfaceTexel> culled = draw(model, camera, {true});
+      const std::vector<shader::SurfaceTexel> all = draw(model, camera, {false});
+      ASSERT_EQ(culled.size(), all.size());
+      size_t covered = 0, differ = 0;
+      for (size_t i = 0; i < all.size(); ++i) {
+        covered += all[i].depth < 1.0f;
+        differ += std::memcmp(&culled[i], &all[i], sizeof(all[i])) != 0;
+      }
+      EXPECT_GT(covered, 100u) << scene.name;
+      EXPECT_EQ(differ, 0u) << scene.name << " " << cameraName(camera) << ": " << covered << " covered";
+    }
+  }
+}
+
+TEST_F(GpuTubeTess, aOnePointTubeIsASphere) {
+  Tractogram t;
+  const float one[] = {0, 0, 0};
+  t.addStreamline(one, 1);
+  TubeBuildOptions o;
+  o.radius.radius = 2.0f;
+  const TubeModel model = buildTubes(t, o);
+  Camera camera;
+  camera.eye = {3, 4, 30};
+  camera.width = 64;
+  camera.height = 64;
+  camera.near_mm = 20;
+  camera.far_mm = 40;
+  const Agreement a =
+      compareWithReference(draw(model, camera), renderReferenceTubes(model, camera, TubeReferenceMethod::Cascade), camera);
+  EXPECT_GE(a.coverage.agreement, 0.95) << a.summary();  // a disk of radius 7.9 px: 194 pixels
+  EXPECT_LE(a.coverage.maxDistance(), 1.0) << a.summary();
+  EXPECT_LE(a.max_depth_mm, 2.0 * (1.0 - std::cos(std::numbers::pi / 8))) << a.summary();
+}
+
+// withTubeStage's list with its method-switching stage swapped for the
+// tessellation stage.
+FrameStageList withTessTubeStage(const GpuTubes* tubes) {
+  FrameStageList stages = withTubeStage(standardFrameStages(), tubes);
+  using Factory = std::unique_ptr<FrameStage> (*)(const gpu::VulkanContext&);
+  for (size_t i = 0; i + 1 < stages.size(); ++i) {
+    const Factory* next = stages[i + 1].target<Factory>();
+    if (!stages[i].target<Factory>() && next && *next == &makeSurfaceMergeStage) {
+      stages[i] = tubeTessellationStage(tubes);
+      break;
+    }
+  }
+  EXPECT_EQ(stages.size(), standardFrameStages().size() + 1);
+  return stages;
+}
+
+// As the ray casters' test (tube_test_scenes.h's lines-and-tubes scene,
+// seen from +z): tube pixels where the reference tube is nearer than the
+// reference lines, line pixels where the lines are nearer.
+TEST_F(GpuTubeTess, tubesAndLinesOccludeEachOtherBothWaysAsTheReferences) {
+  constexpr uint32_t w = 128, h = 96;
+  const test::LinesAndTubesScene setup = test::linesAndTubesScene(0.25f, w, h);
+  const TubeModel model = buildTubes(setup.tubes, setup.options);
+  const Camera& camera = setup.camera;
+  const ReferenceFrame line_ref = rasterizeReference(setup.lines, camera, 2.0f);
+  const TubeReferenceImage tube_ref = renderReferenceTubes(model, camera, TubeReferenceMethod::Cascade);
+  std::vector<uint8_t> want_tube(size_t(w) * h), want_line(size_t(w) * h);
+  size_t lines_over_tubes = 0, tubes_over_lines = 0;
+  for (size_t i = 0; i < want_tube.size(); ++i) {
+    const bool t = tube_ref.fiber[i] != shader::kNoFiberId, l = line_ref.fiber[i] != kNoFiber;
+    want_tube[i] = t && (!l || tube_ref.depth[i] < line_ref.depth[i]);
+    want_line[i] = l && !want_tube[i];
+    lines_over_tubes += t && want_line[i];
+    tubes_over_lines += l && want_tube[i];
+  }
+  ASSERT_GT(lines_over_tubes, 100u);
+  ASSERT_GT(tubes_over_lines, 100u);
+
+  const TractogramUpload upload = uploadTractogram(context(), setup.lines, "lines");
+  const GpuRawTractogram raw = GpuRawTractogram::upload(context(), setup.lines, "lines");
+  GpuTubes tubes = uploadTubes(context(), model);
+  try {
+    FrameRenderer renderer(context(), w, h, withTessTubeStage(&tubes));
+    const GpuScene scene(&upload.dataset, &raw);
+    for (const RenderPipeline pipeline : {RenderPipeline::Compute, RenderPipeline::RawCompute}) {
+      SCOPED_TRACE(std::string(renderPipelineName(pipeline)));
+      RenderSettings settings;
+      settings.pipeline = pipeline;
+      settings.line_width_px = 2.0f;
+      const FrameStats stats = renderer.render(camera, settings, scene);
+      const auto texels = downloadGBuffer(context(), renderer.targets());
+      std::vector<uint8_t> got_tube, got_line;
+      for (const shader::GBufferTexel& t : texels) {
+        const bool tube = t.segment == (shader::kGBufferSurface | shader::kSurfaceSourceTube);
+        got_tube.push_back(tube);
+        got_line.push_back(!tube && t.fiber != shader::kNoFiberId);
+      }
+      const CoverageComparison ct = compareCoverage(got_tube, want_tube, w, h);
+      const CoverageComparison cl = compareCoverage(got_line, want_line, w, h);
+      EXPECT_GE(ct.agreement, 0.98) << "tubes: " << ct.summary();
+      EXPECT_LE(ct.maxDistance(), 1.0) << "tubes: " << ct.summary();
+      EXPECT_GE(cl.agreement, 0.98) << "lines: " << cl.summary();
+      EXPECT_LE(cl.maxDistance(), 1.0) << "lines: " << cl.summary();
+      bool timed_tess = false;
+      for (const PassTiming& p : stats.passes) timed_tess |= p.name == "tube tess";
+      EXPECT_TRUE(timed_tess);
+    }
+  } catch (...) {
+    destroyTubes(context(), tubes);
+    throw;
+  }
+  destroyTubes(context(), tubes);
+}
+
+TEST_F(GpuTubeTess, anEmptyModelDrawsNothing) {
+  const TubeModel empty = buildTubes(Tractogram(), {});
+  Camera camera;
+  camera.eye = {0, 0, 30};
+  camera.width = 32;
+  camera.height = 24;
+  FrameStats stats;
+  const std::vector<shader::SurfaceTexel> surface = draw(empty, camera, {}, &stats);
+  for (const shader::SurfaceTexel& t : surface) ASSERT_EQ(t.depth, 1.0f);
+  for (const PassTiming& p : stats.passes) EXPECT_NE(p.name, "tube tess");
+  // And a model wholly behind the camera runs the passes and draws nothing.
+  Tractogram t;
+  const float xyz[] = {-1, 0, 40, 1, 0, 40, 2, 1, 41};
+  t.addStreamline(xyz, 3);
+  TubeBuildOptions o;
+  o.radius.radius = 0.5f;
+  const std::vector<shader::SurfaceTexel> behind = draw(buildTubes(t, o), camera, {}, &stats);
+  for (const shader::SurfaceTexel& s : behind) ASSERT_EQ(s.depth, 1.0f);
+  bool timed = false;
+  for (const PassTiming& p : stats.passes) timed |= p.name == "tube tess";
+  EXPECT_TRUE(timed);
+}
+
+}  // namespace
+}  // namespace fibscope
