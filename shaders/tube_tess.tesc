@@ -125,10 +125,15 @@ void main() {
       cull();
       return;
     }
-    // Meridians: a quarter arc from the seam to the pole.
+    // Meridians: a quarter arc from the seam to the pole, in at least
+    // vertices / 2 pieces (the finer seam: the cap's triangles, 2 pi /
+    // vertices wide at the seam, are half as tall, so their circumradius
+    // on the sphere, half the diagonal, stays near the body's facets' and
+    // the cap as close to its sphere), refined as the body's edges.
     const float r = tubeTessRadius(g, u), quarter = 0.5 * kTubeTessPi;
-    outer0 = max(edgeLevel(p0, pole, quarter * r), silhouetteLevel(p0, n0, pole, np, r, quarter));
-    outer2 = max(edgeLevel(p1, pole, quarter * r), silhouetteLevel(p1, n1, pole, np, r, quarter));
+    const float base = ceil(float(pc.vertices) / 2.0);
+    outer0 = max(base, max(edgeLevel(p0, pole, quarter * r), silhouetteLevel(p0, n0, pole, np, r, quarter)));
+    outer2 = max(base, max(edgeLevel(p1, pole, quarter * r), silhouetteLevel(p1, n1, pole, np, r, quarter)));
     outer1 = ringEdgeLevel(g, u, k);  // the seam: the body's end ring edge
     outer3 = 1.0;                     // the pole, a point
   }

@@ -27,9 +27,6 @@ layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer Se
 
 layout(location = 0) patch in uint patch_index;
 
-// Both draws rasterise the same depths (shared/tube_tess.h).
-invariant gl_Position;
-
 layout(location = 0) out vec3 out_normal;
 layout(location = 1) out vec3 out_tangent;  // 0: none (a one-point tube)
 layout(location = 2) out float out_position;
