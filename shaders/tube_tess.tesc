@@ -1,7 +1,8 @@
 // Spline tubes by adaptive tessellation, control stage (shared/tube_tess.h;
 // seed section 3.1, figure 8): one patch of one control point per base-mesh
-// quad. Culls the caps between joined segments and, with back-patch
-// culling on, a patch whose corners all face away from the eye; sets each
+// quad. Culls the caps between joined segments and, with culling on, a
+// patch whose corners all face away from the eye or that lies outside the
+// frustum; sets each
 // outer level from its edge alone (canonical corner order, so neighbours
 // agree: no cracks) by the screen-space edge-length criterion and, on ring
 // edges the silhouette crosses, the silhouette criterion; inner levels are
@@ -67,6 +68,28 @@ float ringEdgeLevel(TubeTessSegment g, float u, uint k) {
   return max(edgeLevel(p0, p1, distance(p0, p1)), silhouetteLevel(p0, n0, p1, n1, tubeTessRadius(g, u), span));
 }
 
+// The sphere (c, radius) wholly outside one of the frustum's planes: the
+// rows of view_projection give them (Gribb and Hartmann), in Vulkan's clip
+// depth [0, w].
+bool outsideFrustum(vec3 c, float radius) {
+  const vec4 m0 = cam.view_projection[0], m1 = cam.view_projection[1], m2 = cam.view_projection[2],
+             m3 = cam.view_projection[3];
+  const vec4 rx = vec4(m0.x, m1.x, m2.x, m3.x), ry = vec4(m0.y, m1.y, m2.y, m3.y);
+  const vec4 rz = vec4(m0.z, m1.z, m2.z, m3.z), rw = vec4(m0.w, m1.w, m2.w, m3.w);
+  const vec4 planes[6] = vec4[6](rw + rx, rw - rx, rw + ry, rw - ry, rz, rw - rz);
+  for (int i = 0; i < 6; ++i)
+    if (dot(planes[i].xyz, c) + planes[i].w < -radius * length(planes[i].xyz)) return true;
+  return false;
+}
+
+// Frustum test of a patch with these corners on a tube of radius r.
+bool patchOutside(vec3 p0, vec3 p1, vec3 p2, vec3 p3, float r) {
+  if ((pc.flags & kTubeTessFlagFrustumCulling) == 0u) return false;
+  const vec3 c = 0.25 * (p0 + p1 + p2 + p3);
+  const float reach = max(max(distance(c, p0), distance(c, p1)), max(distance(c, p2), distance(c, p3)));
+  return outsideFrustum(c, reach * (1.0 + kTubeTessBulge) + kTubeTessBulge * r);
+}
+
 bool facesAway(vec3 p, vec3 n) { return dot(n, normalize(cam.eye.xyz - p)) < -kTubeTessBackMargin; }
 
 void cull() {
@@ -100,7 +123,8 @@ void main() {
     vec3 n00, n10, n01, n11;  // corner (around, along)
     const vec3 p00 = tubeTessBodyPoint(g, u0, a0, n00), p10 = tubeTessBodyPoint(g, u0, a1, n10);
     const vec3 p01 = tubeTessBodyPoint(g, u1, a0, n01), p11 = tubeTessBodyPoint(g, u1, a1, n11);
-    if (back_culling && facesAway(p00, n00) && facesAway(p10, n10) && facesAway(p01, n01) && facesAway(p11, n11)) {
+    if ((back_culling && facesAway(p00, n00) && facesAway(p10, n10) && facesAway(p01, n01) && facesAway(p11, n11)) ||
+        patchOutside(p00, p10, p01, p11, max(tubeTessRadius(g, u0), tubeTessRadius(g, u1)))) {
       cull();
       return;
     }
@@ -121,7 +145,8 @@ void main() {
     vec3 n0, n1, np;
     const vec3 p0 = tubeTessBodyPoint(g, u, a0, n0), p1 = tubeTessBodyPoint(g, u, a1, n1);
     const vec3 pole = tubeTessCapPoint(g, cap, a0, 1.0, np);
-    if (back_culling && facesAway(p0, n0) && facesAway(p1, n1) && facesAway(pole, np)) {
+    if ((back_culling && facesAway(p0, n0) && facesAway(p1, n1) && facesAway(pole, np)) ||
+        patchOutside(p0, p1, pole, pole, tubeTessRadius(g, u))) {
       cull();
       return;
     }

@@ -72,6 +72,12 @@ TUBE_TESS_CONST float kTubeTessBackMargin = 0.1f;
 TUBE_TESS_CONST uint kTubeTessModeKeys = 0u;    // draw 1: atomicMin of the keys
 TUBE_TESS_CONST uint kTubeTessModeTexels = 1u;  // draw 2: the winner writes its texel
 TUBE_TESS_CONST uint kTubeTessFlagBackCulling = 1u;
+// Frustum culling: a patch is dropped when the sphere around its corners,
+// widened by how far the surface between them bulges out (at most the
+// faceting and ring-spacing errors, bounded by kTubeTessBulge of the
+// sphere's radius plus the tube's), lies outside a frustum plane.
+TUBE_TESS_CONST uint kTubeTessFlagFrustumCulling = 2u;
+TUBE_TESS_CONST float kTubeTessBulge = 0.25f;
 
 SHADER_FN uint tubeTessPatchesPerSegment(uint rings, uint vertices) { return (rings + 2u) * vertices; }
 

@@ -4,7 +4,8 @@
 // tube model: coverage and fiber ids agree, silhouettes within a pixel,
 // depths within the tessellation's own error (derived below from the
 // geometry: faceting, ring spacing, the model difference); rings do not
-// twist on sharp turns and a helix; back-patch culling changes no texel;
+// twist on sharp turns and a helix; back-patch and frustum culling change
+// no texel;
 // tubes and lines occlude each other both ways; a one-point tube is a
 // sphere; an empty model draws nothing. Validation layers on; frames
 // <= 128 x 96. FIBSCOPE_TUBE_TESS_PNG=DIR writes the images' normals as
@@ -324,20 +325,26 @@ TEST_F(GpuTubeTess, ringsDoNotTwistOnAHelixOrASharpCorner) {
   }
 }
 
-TEST_F(GpuTubeTess, backPatchCullingChangesNoTexel) {
+// Back-patch and frustum culling, each alone and together, against none:
+// the same texels, bit for bit (the close-up cameras put part of the tubes
+// outside the frame).
+TEST_F(GpuTubeTess, patchCullingChangesNoTexel) {
   for (const test::TubeScene& scene : test::tubeScenes()) {
     const TubeModel model = buildTubes(scene.tractogram, scene.options);
     for (const Camera& camera : test::tubeSceneCameras(scene, 96, 72)) {
-      const std::vector<shader::SurfaceTexel> culled = draw(model, camera, {true});
-      const std::vector<shader::SurfaceTexel> all = draw(model, camera, {false});
-      ASSERT_EQ(culled.size(), all.size());
-      size_t covered = 0, differ = 0;
-      for (size_t i = 0; i < all.size(); ++i) {
-        covered += all[i].depth < 1.0f;
-        differ += std::memcmp(&culled[i], &all[i], sizeof(all[i])) != 0;
+      const std::vector<shader::SurfaceTexel> all = draw(model, camera, {false, false});
+      for (const TubeTessOptions culling : {TubeTessOptions{true, false}, TubeTessOptions{false, true}, TubeTessOptions{}}) {
+        const std::vector<shader::SurfaceTexel> culled = draw(model, camera, culling);
+        ASSERT_EQ(culled.size(), all.size());
+        size_t covered = 0, differ = 0;
+        for (size_t i = 0; i < all.size(); ++i) {
+          covered += all[i].depth < 1.0f;
+          differ += std::memcmp(&culled[i], &all[i], sizeof(all[i])) != 0;
+        }
+        EXPECT_GT(covered, 100u) << scene.name;
+        EXPECT_EQ(differ, 0u) << scene.name << " " << cameraName(camera) << ", back " << culling.back_patch_culling
+                              << ", frustum " << culling.frustum_culling << ": " << covered << " covered";
       }
-      EXPECT_GT(covered, 100u) << scene.name;
-      EXPECT_EQ(differ, 0u) << scene.name << " " << cameraName(camera) << ": " << covered << " covered";
     }
   }
 }

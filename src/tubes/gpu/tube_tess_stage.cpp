@@ -81,7 +81,8 @@ class TubeTessStage final : public FrameStage {
     push.rings = uint32_t(std::clamp(frame.settings.tube_rings, 1, 64));
     push.vertices = uint32_t(std::clamp(frame.settings.tube_vertices, 3, 64));
     push.segment_count = tubes_->segment_count;
-    push.flags = options_.back_patch_culling ? shader::kTubeTessFlagBackCulling : 0u;
+    push.flags = (options_.back_patch_culling ? shader::kTubeTessFlagBackCulling : 0u) |
+                 (options_.frustum_culling ? shader::kTubeTessFlagFrustumCulling : 0u);
     const uint32_t patches = tubes_->segment_count * shader::tubeTessPatchesPerSegment(push.rings, push.vertices);
     const uint32_t per_draw = gpu::tessellationPatchesPerDraw(frame.context);
     const auto draw = [&](uint32_t mode) {

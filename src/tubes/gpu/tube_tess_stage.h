@@ -31,9 +31,10 @@
 namespace fibscope {
 
 struct TubeTessOptions {
-  // Back-patch culling in the control stage (off: every patch tessellated,
-  // for the test that culling changes no pixel).
+  // Back-patch and frustum culling in the control stage (off: every patch
+  // tessellated, for the tests that culling changes no texel).
   bool back_patch_culling = true;
+  bool frustum_culling = true;
 };
 
 // "tube tess" and "tube tess texels" into the surface target; runs in
