@@ -34,11 +34,43 @@ void main() {
   const float depth = gl_FragCoord.z;
   if (!(depth >= 0.0 && depth <= 1.0)) return;
   const uint64_t key = (uint64_t(floatBitsToUint(depth)) << 32) | uint64_t(in_patch);
-  if (pc.mode == kTubeTessModeKeys) {
-    atomicMin(KeysRef(pc.visibility).keys[index], key);
-    return;
+  KeysRef keys = KeysRef(pc.visibility);
+  if (pc.samples <= 1u) {
+    if (pc.mode == kTubeTessModeKeys) {
+      atomicMin(keys.keys[index], key);
+      return;
+    }
+    if (keys.keys[index] != key) return;
+  } else {
+    // Supersampled coverage (shared/tube_tess.h): a key per sample.
+    const uint base = index * pc.samples, mask = uint(gl_SampleMaskIn[0]);
+    if (pc.mode == kTubeTessModeKeys) {
+      for (uint k = 0u; k < pc.samples; ++k)
+        if (((mask >> k) & 1u) != 0u) atomicMin(keys.keys[base + k], key);
+      return;
+    }
+    // The pixel is the tubes' when half its samples are; its texel is that
+    // of the fragment nearest at the most samples (ties: the nearer).
+    uint64_t sample_keys[8];
+    uint covered = 0u;
+    for (uint k = 0u; k < pc.samples; ++k) {
+      sample_keys[k] = keys.keys[base + k];
+      covered += sample_keys[k] != 0xFFFFFFFFFFFFFFFFul ? 1u : 0u;
+    }
+    if (2u * covered < pc.samples) return;
+    uint64_t winner = 0xFFFFFFFFFFFFFFFFul;
+    uint most = 0u;
+    for (uint k = 0u; k < pc.samples; ++k) {
+      if (sample_keys[k] == 0xFFFFFFFFFFFFFFFFul) continue;
+      uint n = 0u;
+      for (uint j = 0u; j < pc.samples; ++j) n += sample_keys[j] == sample_keys[k] ? 1u : 0u;
+      if (n > most || (n == most && sample_keys[k] < winner)) {
+        most = n;
+        winner = sample_keys[k];
+      }
+    }
+    if (winner != key) return;
   }
-  if (KeysRef(pc.visibility).keys[index] != key) return;
   SurfaceRef surface = SurfaceRef(pc.surface);
   if (!(depth < surface.texels[index].depth)) return;
   SurfaceTexel texel;

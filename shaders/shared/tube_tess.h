@@ -32,6 +32,18 @@
 // both, the pass as a push constant, because the second draw must
 // rasterise exactly the first one's depths (the keys are compared for
 // equality), which two pipelines do not guarantee.
+//
+// tube_msaa (samples > 1): the surface target holds one texel per pixel,
+// which shading, picking, SSAO and the merge with the lines read, so true
+// MSAA (a texel per sample, blended) would change every consumer. What is
+// done instead is supersampled coverage: the draws rasterise `samples`
+// samples a pixel (one fragment a pixel, depth at the pixel centre); draw
+// 1 keeps one key per sample (each covered sample of gl_SampleMaskIn); in
+// draw 2 a pixel is the tubes' when at least half its samples are covered
+// (by area, not by its centre alone), and the fragment that is nearest at
+// the most of its samples writes the texel (ties: the nearer). Edges then follow the
+// covered area rather than the pixel centre; the image's antialiasing
+// stays FXAA's.
 #ifndef FIBSCOPE_SHADERS_SHARED_TUBE_TESS_H
 #define FIBSCOPE_SHADERS_SHARED_TUBE_TESS_H
 
@@ -93,13 +105,15 @@ struct TubeTessPush {
   uint segment_count;   // segments in the tubes buffer (joins are looked up)
   uint mode;            // kTubeTessMode*
   uint flags;           // kTubeTessFlag*
+  uint samples;         // rasterisation samples (tube_msaa): keys per pixel
+  uint pad0;
 };
 
 SHADER_NAMESPACE_END
 
 #ifdef __cplusplus
 #include <cstddef>
-static_assert(sizeof(fibscope::shader::TubeTessPush) == 64, "");
+static_assert(sizeof(fibscope::shader::TubeTessPush) == 72, "");
 static_assert(offsetof(fibscope::shader::TubeTessPush, width) == 40, "");
 #endif
 

@@ -4,7 +4,8 @@
 // tube model: coverage and fiber ids agree, silhouettes within a pixel,
 // depths within the tessellation's own error (derived below from the
 // geometry: faceting, ring spacing, the model difference); rings do not
-// twist on sharp turns and a helix; back-patch and frustum culling change
+// twist on sharp turns and a helix; supersampled coverage (tube_msaa)
+// matches too; back-patch and frustum culling change
 // no texel;
 // tubes and lines occlude each other both ways; a one-point tube is a
 // sphere; an empty model draws nothing. Validation layers on; frames
@@ -22,6 +23,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "core/error.h"
 #include "gpu_render_test_support.h"
 #include "gpu_test_context.h"
 #include "io/png_writer.h"
@@ -286,6 +288,80 @@ TEST_F(GpuTubeTess, tessellatedTubesMatchTheRayCastReferenceOnCurvedTubes) {
         EXPECT_TRUE(isTubePass(p.name) || p.name.rfind("tube", 0) != 0) << p.name;
       }
       EXPECT_TRUE(timed_keys && timed_texels);
+    }
+  }
+}
+
+// tube_msaa 4 and 8: supersampled coverage (a pixel is the tube's when half
+// its samples are covered, its texel the fragment nearest at most of them)
+// against the reference's pixel centres: the two estimators differ on
+// edge pixels only, so silhouettes within a pixel, disagreements no more
+// than the reference's edge pixels, and the same surface bounds as one
+// sample.
+TEST_F(GpuTubeTess, supersampledCoverageMatchesTheReference) {
+  for (const int samples : {4, 8}) {
+    if ((context().limits().framebufferNoAttachmentsSampleCounts & uint32_t(samples)) == 0) {
+      // Refused with a message, not drawn wrong.
+      std::printf("tube-msaa %d: not among the device's framebufferNoAttachmentsSampleCounts: refused\n", samples);
+      RenderSettings settings;
+      settings.tube_msaa = samples;
+      const test::TubeScene scene = test::tubeScenes()[0];
+      const TubeModel model = buildTubes(scene.tractogram, scene.options);
+      try {
+        draw(model, test::tubeSceneCameras(scene, 32, 24)[0], {}, nullptr, settings);
+        ADD_FAILURE() << "tube-msaa " << samples << " drawn on a device without it";
+      } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("tube-msaa"), std::string::npos) << e.what();
+      }
+      continue;
+    }
+    RenderSettings settings;
+    settings.tube_msaa = samples;
+    for (const test::TubeScene& scene : test::tubeScenes()) {
+      const TubeModel model = buildTubes(scene.tractogram, scene.options);
+      const Tolerance tolerance = tessellationTolerance(model, settings.tube_rings, settings.tube_vertices);
+      const Camera camera = test::tubeSceneCameras(scene, 120, 90)[1];
+      const std::vector<shader::SurfaceTexel> got = draw(model, camera, {}, nullptr, settings);
+      const TubeReferenceImage reference = renderReferenceTubes(model, camera, TubeReferenceMethod::Cascade);
+      const Agreement a =
+          compareWithReference(got, reference, camera, settings.tube_vertices, scene.max_radius, tolerance);
+      const std::string what = std::to_string(samples) + " samples, " + scene.name + ": " + a.summary();
+      EXPECT_GT(a.both, 250u) << what;
+      // Only pixels on the reference's edges (covered next to uncovered, or
+      // next to another fiber or another part of the surface, 4-neighbours,
+      // either side) may go either way.
+      const TubeReferenceImage& ref = reference;
+      size_t edge = 0;
+      for (uint32_t y = 0; y < camera.height; ++y)
+        for (uint32_t x = 0; x < camera.width; ++x) {
+          const size_t i = size_t(y) * camera.width + x;
+          bool differs = false;
+          const int dx[4] = {1, -1, 0, 0}, dy[4] = {0, 0, 1, -1};
+          for (int k = 0; k < 4; ++k) {
+            const int nx = int(x) + dx[k], ny = int(y) + dy[k];
+            if (nx < 0 || ny < 0 || nx >= int(camera.width) || ny >= int(camera.height)) continue;
+            const size_t j = size_t(ny) * camera.width + size_t(nx);
+            differs |= ref.fiber[i] != ref.fiber[j] ||
+                       std::fabs(ref.distance[i] - ref.distance[j]) > 2.0 * scene.max_radius;
+          }
+          edge += differs;
+        }
+      const size_t either = a.coverage.covered_a + a.coverage.covered_b - a.coverage.covered_both;
+      EXPECT_GE(a.agreement(), 1.0 - double(edge) / double(either)) << what << " (" << edge << " edge pixels)";
+      EXPECT_LE(a.coverage.maxDistance(), 1.0) << what;
+      EXPECT_EQ(a.fiber_mismatch, 0u) << what;
+      EXPECT_LE(a.max_depth_mm, tolerance.surface_mm) << what;
+      // An edge pixel's texel may come from a fragment off the pixel centre
+      // (interpolated there from a triangle covering other samples): half
+      // a pixel diagonal on screen, at the farthest hit, along the fiber.
+      double farthest = 0;  // view distance (mm)
+      const double n = camera.near_mm, f = camera.far_mm;
+      for (const shader::SurfaceTexel& t : got)
+        if (t.depth < 1.0f) farthest = std::max(farthest, n * f / (f - double(t.depth) * (f - n)));
+      const double pixel_mm =
+          2.0 * std::tan(0.5 * camera.fov_y_deg * std::numbers::pi / 180.0) / camera.height * farthest;
+      EXPECT_LE(a.position_excess, 0.5 * std::sqrt(2.0) * pixel_mm / tolerance.mm_per_point) << what;
+      EXPECT_LE(a.max_normal_error, 2.0 * std::sin(0.5 * std::numbers::pi / settings.tube_vertices)) << what;
     }
   }
 }

@@ -38,6 +38,10 @@ class TubeTessStage final : public FrameStage {
     if (!c.info().queue_has_graphics) refuse("a graphics queue");
     if (!c.enabledFeatures().tessellationShader) refuse("tessellation shaders (tessellationShader)");
     if (!c.enabledFeatures().fragmentStoresAndAtomics) refuse("fragmentStoresAndAtomics");
+    const uint32_t samples = sampleCount(frame.settings);
+    if (samples == 0 || (c.limits().framebufferNoAttachmentsSampleCounts & samples) == 0)
+      refuse("tube-msaa " + std::to_string(frame.settings.tube_msaa) +
+             " (samples per pixel without attachments, framebufferNoAttachmentsSampleCounts)");
     const uint64_t patches = uint64_t(tubes_ ? tubes_->segment_count : 0) * patchesPerSegment(frame.settings);
     if (patches >= (uint64_t(1) << 32))
       throw Error("tubes: " + std::to_string(tubes_->segment_count) + " segments of " +
@@ -48,6 +52,13 @@ class TubeTessStage final : public FrameStage {
   void resize(const gpu::VulkanContext& context, uint32_t, uint32_t) override { gpu::destroyBuffer(context, keys_); }
 
   void record(FrameContext& frame) override {
+    const uint32_t samples = sampleCount(frame.settings);
+    if (pipeline_.pipeline != VK_NULL_HANDLE && samples != samples_) {
+      vkDeviceWaitIdle(frame.context.device());  // earlier frames may still use them
+      gpu::destroyGraphicsPipeline(frame.context, pipeline_);
+      gpu::destroyBuffer(frame.context, keys_);
+    }
+    samples_ = samples;
     if (pipeline_.pipeline == VK_NULL_HANDLE) {
       gpu::GraphicsPipelineDesc desc;
       desc.vertex_shader = "tube_tess.vert";
@@ -58,11 +69,13 @@ class TubeTessStage final : public FrameStage {
       desc.patch_control_points = 1;
       desc.color_format = VK_FORMAT_UNDEFINED;
       desc.push_constant_bytes = sizeof(shader::TubeTessPush);
+      desc.samples = VkSampleCountFlagBits(samples);
       pipeline_ = gpu::createGraphicsPipeline(frame.context, desc);
     }
     const uint32_t width = frame.targets.width, height = frame.targets.height;
     if (!keys_.buffer)
-      keys_ = gpu::createBuffer(frame.context, frame.targets.pixels() * sizeof(uint64_t), gpu::MemoryUse::DeviceLocal);
+      keys_ = gpu::createBuffer(frame.context, frame.targets.pixels() * samples * sizeof(uint64_t),
+                                gpu::MemoryUse::DeviceLocal);
     // The previous frame's texels draw read the keys before they are cleared.
     gpu::recordBarrier(frame.cmd, {VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, 0, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, 0});
     vkCmdFillBuffer(frame.cmd, keys_.buffer, 0, VK_WHOLE_SIZE, 0xFFFFFFFFu);
@@ -81,6 +94,7 @@ class TubeTessStage final : public FrameStage {
     push.rings = uint32_t(std::clamp(frame.settings.tube_rings, 1, 64));
     push.vertices = uint32_t(std::clamp(frame.settings.tube_vertices, 3, 64));
     push.segment_count = tubes_->segment_count;
+    push.samples = samples;
     push.flags = (options_.back_patch_culling ? shader::kTubeTessFlagBackCulling : 0u) |
                  (options_.frustum_culling ? shader::kTubeTessFlagFrustumCulling : 0u);
     const uint32_t patches = tubes_->segment_count * shader::tubeTessPatchesPerSegment(push.rings, push.vertices);
@@ -111,6 +125,10 @@ class TubeTessStage final : public FrameStage {
   }
 
  private:
+  // tube_msaa as a sample count (1, 4 or 8; 0 for anything else).
+  static uint32_t sampleCount(const RenderSettings& s) {
+    return s.tube_msaa == 1 || s.tube_msaa == 4 || s.tube_msaa == 8 ? uint32_t(s.tube_msaa) : 0u;
+  }
   static uint32_t patchesPerSegment(const RenderSettings& s) {
     return shader::tubeTessPatchesPerSegment(uint32_t(std::clamp(s.tube_rings, 1, 64)),
                                              uint32_t(std::clamp(s.tube_vertices, 3, 64)));
@@ -119,7 +137,8 @@ class TubeTessStage final : public FrameStage {
   const GpuTubes* tubes_;
   TubeTessOptions options_;
   gpu::GraphicsPipeline pipeline_;  // made at the first frame with tubes
-  gpu::Buffer keys_;                // uint64_t visibility key per pixel, row-major
+  gpu::Buffer keys_;                // uint64_t visibility key per pixel (per sample), row-major
+  uint32_t samples_ = 1;            // the pipeline's and the keys' samples
 };
 
 }  // namespace

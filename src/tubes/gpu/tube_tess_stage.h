@@ -16,12 +16,12 @@
 // drawn again lets the winner write its texel where it is strictly nearer
 // than the surface target ("tube tess texels").
 //
-// tube_msaa: the surface target holds one texel per pixel, which shading,
-// picking and the merge with the lines read; this stage samples each pixel
-// at its centre whatever tube_msaa says (see the report / README: MSAA of a
-// storage-buffer G-buffer would need per-sample texels).
+// tube_msaa (1, 4, 8): supersampled coverage, not blended MSAA (the
+// surface target holds one texel per pixel; shared/tube_tess.h says what
+// is done and why).
 //
-// Needs tessellationShader, fragmentStoresAndAtomics and a graphics queue;
+// Needs tessellationShader, fragmentStoresAndAtomics, a graphics queue and
+// tube_msaa among framebufferNoAttachmentsSampleCounts;
 // check() throws Error naming what the device lacks.
 #pragma once
 
