@@ -43,8 +43,9 @@ void main() {
   const TubeTessSegment g = tubeTessSegment(s, a, b);
   const float x = gl_TessCoord.x, y = gl_TessCoord.y;
   // Corners exactly as the control stage's (the last one around is the first).
-  const float around = x <= 0.0 ? tubeTessAround(k, pc.vertices)
-                                : (x >= 1.0 ? tubeTessAround(k + 1u, pc.vertices) : (float(k) + x) / float(pc.vertices));
+  const float around = x <= 0.0   ? tubeTessAround(k, pc.vertices)
+                       : x >= 1.0 ? tubeTessAround(k + 1u, pc.vertices)
+                                  : (float(k) + x) / float(pc.vertices);
   vec3 p, normal;
   float u;
   if (row < pc.rings) {
@@ -73,7 +74,8 @@ void main() {
     // Hermite in the colour, slopes per mm times the chord (as the ray casters).
     const float u2 = u * u, u3 = u2 * u;
     const vec4 ca = unpackUnorm4x8(a.color), cb = unpackUnorm4x8(b.color);
-    const vec4 sa = unpackSnorm4x8(a.color_slope) * kTubeColorSlopeMax, sb = unpackSnorm4x8(b.color_slope) * kTubeColorSlopeMax;
+    const vec4 sa = unpackSnorm4x8(a.color_slope) * kTubeColorSlopeMax;
+    const vec4 sb = unpackSnorm4x8(b.color_slope) * kTubeColorSlopeMax;
     const vec4 col = (2.0 * u3 - 3.0 * u2 + 1.0) * ca + (u3 - 2.0 * u2 + u) * s.chord * sa +
                      (-2.0 * u3 + 3.0 * u2) * cb + (u3 - u2) * s.chord * sb;
     out_color = vec4(clamp(col.rgb, 0.0, 1.0), 1.0);

@@ -29,7 +29,8 @@ inline uint32_t tessellationPatchesPerDraw(const VulkanContext& context) {
 // pipeline and its push constants already bound.
 inline void recordPatchDraws(VkCommandBuffer cmd, uint32_t first, uint32_t count, uint32_t per_draw) {
   const uint32_t chunk = per_draw == 0 ? count : per_draw;
-  for (uint32_t done = 0; done < count; done += chunk) vkCmdDraw(cmd, std::min(chunk, count - done), 1, first + done, 0);
+  for (uint32_t done = 0; done < count; done += chunk)
+    vkCmdDraw(cmd, std::min(chunk, count - done), 1, first + done, 0);
 }
 
 }  // namespace fibscope::gpu

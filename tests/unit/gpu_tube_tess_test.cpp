@@ -140,14 +140,16 @@ Tolerance tessellationTolerance(const TubeModel& model, int rings, int vertices)
         const glm::dvec3 h(tubeSegmentPoint(model, s, u));
         // The Hermite radius at u, as glsl/tube_tess.glsl's.
         const double u2 = double(u) * u, u3 = u2 * u;
-        const double radius = (2 * u3 - 3 * u2 + 1) * a.position_radius.w + (u3 - 2 * u2 + u) * s.chord * a.tangent_dradius.w +
+        const double radius = (2 * u3 - 3 * u2 + 1) * a.position_radius.w +
+                              (u3 - 2 * u2 + u) * s.chord * a.tangent_dradius.w +
                               (-2 * u3 + 3 * u2) * b.position_radius.w + (u3 - u2) * s.chord * b.tangent_dradius.w;
         double best = 1e30, best_u = 0;
         for (uint32_t half = 0; half < 2; ++half) {
           const shader::TubeQuadratic q = tubeSubSegment(model, 2 * index + half);
           for (int j = 0; j <= 256; ++j) {
             const double t = j / 256.0;
-            const double e = glm::distance(h, tubeQuadraticCenter(q, t)) + std::fabs(radius - tubeQuadraticRadius(q, t));
+            const double e =
+                glm::distance(h, tubeQuadraticCenter(q, t)) + std::fabs(radius - tubeQuadraticRadius(q, t));
             if (e < best) {
               best = e;
               best_u = 0.5 * (half + t);
@@ -187,7 +189,8 @@ struct Agreement {
            " on another part of the surface, " + std::to_string(fiber_mismatch) + " fibers differ, depth error " +
            std::to_string(max_depth_mm) + " mm on " + std::to_string(facing) + " facing pixels (at " +
            std::to_string(worst_x) + ", " + std::to_string(worst_y) + ", cos " + std::to_string(worst_cosine) +
-           "), normal " + std::to_string(max_normal_error) + ", position " + std::to_string(max_position_error) + " (excess " + std::to_string(position_excess) + ")";
+           "), normal " + std::to_string(max_normal_error) + ", position " + std::to_string(max_position_error) +
+           " (excess " + std::to_string(position_excess) + ")";
   }
 };
 
@@ -341,8 +344,8 @@ TEST_F(GpuTubeTess, supersampledCoverageMatchesTheReference) {
             const int nx = int(x) + dx[k], ny = int(y) + dy[k];
             if (nx < 0 || ny < 0 || nx >= int(camera.width) || ny >= int(camera.height)) continue;
             const size_t j = size_t(ny) * camera.width + size_t(nx);
-            differs |= ref.fiber[i] != ref.fiber[j] ||
-                       std::fabs(ref.distance[i] - ref.distance[j]) > 2.0 * scene.max_radius;
+            differs |=
+                ref.fiber[i] != ref.fiber[j] || std::fabs(ref.distance[i] - ref.distance[j]) > 2.0 * scene.max_radius;
           }
           edge += differs;
         }
@@ -391,13 +394,14 @@ TEST_F(GpuTubeTess, ringsDoNotTwistOnAHelixOrASharpCorner) {
     b.min[k] -= 0.45f;
     b.max[k] += 0.45f;
   }
-  for (const Camera& camera : {fitCamera(b, {0, 0, 1}, {0, 1, 0}, 128, 96), fitCamera(b, {1, -0.5, 0.3}, {0, 0, 1}, 128, 96)}) {
+  for (const Camera& camera :
+       {fitCamera(b, {0, 0, 1}, {0, 1, 0}, 128, 96), fitCamera(b, {1, -0.5, 0.3}, {0, 0, 1}, 128, 96)}) {
     const std::vector<shader::SurfaceTexel> got = draw(model, camera);
     maybeWritePng("tess helix " + cameraName(camera), got, camera);
-    const Agreement a =
-        compareWithReference(got, renderReferenceTubes(model, camera, TubeReferenceMethod::Cascade), camera,
-                             defaults.tube_vertices, 0.45, tolerance);
-    expectMatchesReference(a, tolerance, defaults.tube_vertices, "helix and corner " + cameraName(camera) + ": " + a.summary());
+    const Agreement a = compareWithReference(got, renderReferenceTubes(model, camera, TubeReferenceMethod::Cascade),
+                                             camera, defaults.tube_vertices, 0.45, tolerance);
+    expectMatchesReference(a, tolerance, defaults.tube_vertices,
+                           "helix and corner " + cameraName(camera) + ": " + a.summary());
   }
 }
 
@@ -409,7 +413,8 @@ TEST_F(GpuTubeTess, patchCullingChangesNoTexel) {
     const TubeModel model = buildTubes(scene.tractogram, scene.options);
     for (const Camera& camera : test::tubeSceneCameras(scene, 96, 72)) {
       const std::vector<shader::SurfaceTexel> all = draw(model, camera, {false, false});
-      for (const TubeTessOptions culling : {TubeTessOptions{true, false}, TubeTessOptions{false, true}, TubeTessOptions{}}) {
+      for (const TubeTessOptions culling :
+           {TubeTessOptions{true, false}, TubeTessOptions{false, true}, TubeTessOptions{}}) {
         const std::vector<shader::SurfaceTexel> culled = draw(model, camera, culling);
         ASSERT_EQ(culled.size(), all.size());
         size_t covered = 0, differ = 0;
@@ -439,8 +444,8 @@ TEST_F(GpuTubeTess, aOnePointTubeIsASphere) {
   camera.near_mm = 20;
   camera.far_mm = 40;
   const Agreement a =
-      compareWithReference(draw(model, camera), renderReferenceTubes(model, camera, TubeReferenceMethod::Cascade), camera,
-                           8, 2.0, tessellationTolerance(model, 16, 8));
+      compareWithReference(draw(model, camera), renderReferenceTubes(model, camera, TubeReferenceMethod::Cascade),
+                           camera, 8, 2.0, tessellationTolerance(model, 16, 8));
   EXPECT_GE(a.agreement(), 0.95) << a.summary();  // a disk of radius 7.9 px: 194 pixels
   EXPECT_LE(a.coverage.maxDistance(), 1.0) << a.summary();
   EXPECT_LE(a.max_depth_mm, 2.0 * (1.0 - std::cos(std::numbers::pi / 8))) << a.summary();

@@ -77,7 +77,8 @@ class TubeTessStage final : public FrameStage {
       keys_ = gpu::createBuffer(frame.context, frame.targets.pixels() * samples * sizeof(uint64_t),
                                 gpu::MemoryUse::DeviceLocal);
     // The previous frame's texels draw read the keys before they are cleared.
-    gpu::recordBarrier(frame.cmd, {VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, 0, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, 0});
+    gpu::recordBarrier(frame.cmd,
+                       {VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, 0, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, 0});
     vkCmdFillBuffer(frame.cmd, keys_.buffer, 0, VK_WHOLE_SIZE, 0xFFFFFFFFu);
     // The clear, the camera block and the surface target the earlier
     // stages wrote (transfer or compute), before the draws' shaders.
@@ -116,10 +117,10 @@ class TubeTessStage final : public FrameStage {
     }
     {
       // The surface texels before the merge (compute) or another surface.
-      gpu::PassScope pass(frame.cmd, frame.timer, "tube tess texels",
-                          {VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, gpu::kStorageReadWrite,
-                           VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-                           gpu::kStorageReadWrite});
+      gpu::PassScope pass(
+          frame.cmd, frame.timer, "tube tess texels",
+          {VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, gpu::kStorageReadWrite,
+           VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, gpu::kStorageReadWrite});
       draw(shader::kTubeTessModeTexels);
     }
   }
