@@ -5,7 +5,8 @@
 // depths within the tessellation's own error (derived below from the
 // geometry: faceting, ring spacing, the model difference); rings do not
 // twist on sharp turns and a helix; supersampled coverage (tube_msaa)
-// matches too; back-patch and frustum culling change
+// matches too; the tube's colour along it as the
+// compute ray caster's; back-patch and frustum culling change
 // no texel;
 // tubes and lines occlude each other both ways; a one-point tube is a
 // sphere; an empty model draws nothing. Validation layers on; frames
@@ -292,6 +293,71 @@ TEST_F(GpuTubeTess, tessellatedTubesMatchTheRayCastReferenceOnCurvedTubes) {
       }
       EXPECT_TRUE(timed_keys && timed_texels);
     }
+  }
+}
+
+// The tube's own colour (per point, Hermite along the tube) and the
+// fiber, position and normal against the compute ray caster's texels on
+// the pixels both cover and the surface faces the eye: a colour channel
+// differs by at most the colour's slope per point times the two texels'
+// difference in position along the fiber, plus the 8-bit rounding of both.
+TEST_F(GpuTubeTess, colourAlongTheTubeMatchesTheComputeRayCaster) {
+  test::TubeScene scene = test::tubeScenes()[1];  // the S-curve of varying radius
+  std::vector<float> rgb;
+  const size_t points = scene.tractogram.pointsIn(0);
+  for (size_t i = 0; i < points; ++i) {
+    const float v = float(i) / float(points - 1);
+    rgb.insert(rgb.end(), {v, 1.0f - v, 0.5f + 0.4f * std::sin(6.0f * v)});
+  }
+  scene.tractogram.per_point.push_back({"rgb", 3, "float32", rgb});
+  scene.options.color.source = TubeColor::Source::PerPoint;
+  scene.options.color.array = "rgb";
+  const TubeModel model = buildTubes(scene.tractogram, scene.options);
+  double slope_per_point = 0;  // largest |d colour / d point| over the nodes
+  for (const shader::TubeSegment& s : model.segments) {
+    const shader::TubeNode &a = model.nodes[s.node], &b = model.nodes[s.node + 1];
+    const double mm_per_point = s.chord / std::max(1e-6, double(b.point - a.point));
+    for (const shader::TubeNode* n : {&a, &b})
+      for (int k = 0; k < 3; ++k) {
+        const int8_t q = int8_t((n->color_slope >> (8 * k)) & 0xFFu);
+        slope_per_point =
+            std::max(slope_per_point, std::fabs(double(q) / 127.0 * shader::kTubeColorSlopeMax) * mm_per_point);
+      }
+  }
+  for (const Camera& camera : test::tubeSceneCameras(scene, 120, 90)) {
+    const std::vector<shader::SurfaceTexel> tess = draw(model, camera);
+    GpuTubes tubes = uploadTubes(context(), model);
+    std::vector<shader::SurfaceTexel> cast;
+    try {
+      FrameRenderer renderer(context(), camera.width, camera.height, {makeSetupStage, tubeRaycastStage(&tubes)});
+      renderer.render(camera, RenderSettings(), GpuScene());
+      cast = downloadSurface(context(), renderer.targets());
+    } catch (...) {
+      destroyTubes(context(), tubes);
+      throw;
+    }
+    destroyTubes(context(), tubes);
+    size_t compared = 0, coloured = 0;
+    double worst = 0;
+    for (size_t i = 0; i < tess.size(); ++i) {
+      if (!(tess[i].depth < 1.0f && cast[i].depth < 1.0f)) continue;
+      const std::array<float, 3> nc = test::unpackTangent(cast[i].normal);
+      glm::dvec3 o, d;
+      tubePixelRay(camera, uint32_t(i % camera.width), uint32_t(i / camera.width), o, d);
+      if (std::fabs(glm::dot(glm::dvec3(nc[0], nc[1], nc[2]), d)) < kFacing) continue;
+      ++compared;
+      EXPECT_EQ(tess[i].fiber, cast[i].fiber);
+      coloured += (tess[i].color >> 24) == 255u && (cast[i].color >> 24) == 255u;
+      const double allowed = slope_per_point * std::fabs(tess[i].position - cast[i].position) + 2.0 / 255.0;
+      for (int k = 0; k < 3; ++k) {
+        const double ct = double((tess[i].color >> (8 * k)) & 0xFFu) / 255.0;
+        const double cc = double((cast[i].color >> (8 * k)) & 0xFFu) / 255.0;
+        worst = std::max(worst, std::fabs(ct - cc) - allowed);
+      }
+    }
+    EXPECT_GT(compared, 100u) << cameraName(camera);
+    EXPECT_EQ(coloured, compared) << cameraName(camera);
+    EXPECT_LE(worst, 0.0) << cameraName(camera) << ": a channel off by " << worst << " beyond the bound";
   }
 }
 
