@@ -435,6 +435,38 @@ TEST_F(GpuTubeTess, supersampledCoverageMatchesTheReference) {
   }
 }
 
+// One renderer switching tube_msaa 1 -> 4 -> 1 between frames (the
+// pipeline and the keys remade) gives each frame a fresh renderer's texels.
+TEST_F(GpuTubeTess, switchingSamplesBetweenFramesGivesFreshFrames) {
+  if ((context().limits().framebufferNoAttachmentsSampleCounts & 4u) == 0) GTEST_SKIP() << "no 4 samples";
+  const test::TubeScene scene = test::tubeScenes()[0];
+  const TubeModel model = buildTubes(scene.tractogram, scene.options);
+  const Camera camera = test::tubeSceneCameras(scene, 64, 48)[1];
+  RenderSettings one, four;
+  four.tube_msaa = 4;
+  const std::vector<shader::SurfaceTexel> fresh_one = draw(model, camera, {}, nullptr, one);
+  const std::vector<shader::SurfaceTexel> fresh_four = draw(model, camera, {}, nullptr, four);
+  GpuTubes tubes = uploadTubes(context(), model);
+  try {
+    FrameRenderer renderer(context(), camera.width, camera.height, {makeSetupStage, tubeTessellationStage(&tubes)});
+    const RenderSettings* sequence[3] = {&one, &four, &one};
+    const std::vector<shader::SurfaceTexel>* expected[3] = {&fresh_one, &fresh_four, &fresh_one};
+    for (int f = 0; f < 3; ++f) {
+      renderer.render(camera, *sequence[f], GpuScene());
+      const std::vector<shader::SurfaceTexel> got = downloadSurface(context(), renderer.targets());
+      ASSERT_EQ(got.size(), expected[f]->size());
+      EXPECT_EQ(std::memcmp(got.data(), expected[f]->data(), got.size() * sizeof(got[0])), 0) << "frame " << f;
+    }
+  } catch (...) {
+    destroyTubes(context(), tubes);
+    throw;
+  }
+  destroyTubes(context(), tubes);
+  size_t differ = 0;
+  for (size_t i = 0; i < fresh_one.size(); ++i) differ += (fresh_one[i].depth < 1.0f) != (fresh_four[i].depth < 1.0f);
+  EXPECT_GT(differ, 0u) << "4 samples changed no pixel's coverage";
+}
+
 // Rings that twisted between nodes would pinch the tube (its cross-section
 // a collapsed circle where the frame turns about the tangent): a helix of
 // tight pitch and a 90-degree corner taken within two segments, both

@@ -30,52 +30,31 @@ class TubeTessStage final : public FrameStage {
   uint32_t maxPasses() const override { return 2; }
   bool runs(const FrameContext&) const override { return tubes_ && tubes_->segment_count > 0; }
   bool drawsSurfaces() const override { return true; }
-  void check(const FrameContext& frame) const override {
-    const gpu::VulkanContext& c = frame.context;
-    const auto refuse = [&](const std::string& what) {
-      throw Error("tubes: tessellated tubes need " + what + ", which " + c.info().name + " lacks");
-    };
-    if (!c.info().queue_has_graphics) refuse("a graphics queue");
-    if (!c.enabledFeatures().tessellationShader) refuse("tessellation shaders (tessellationShader)");
-    if (!c.enabledFeatures().fragmentStoresAndAtomics) refuse("fragmentStoresAndAtomics");
-    const uint32_t samples = sampleCount(frame.settings);
-    if (samples == 0 || (c.limits().framebufferNoAttachmentsSampleCounts & samples) == 0)
-      refuse("tube-msaa " + std::to_string(frame.settings.tube_msaa) +
-             " (samples per pixel without attachments, framebufferNoAttachmentsSampleCounts)");
-    const uint64_t patches = uint64_t(tubes_ ? tubes_->segment_count : 0) * patchesPerSegment(frame.settings);
-    if (patches >= (uint64_t(1) << 32))
-      throw Error("tubes: " + std::to_string(tubes_->segment_count) + " segments of " +
-                  std::to_string(patchesPerSegment(frame.settings)) +
-                  " patches each is more than the 2^32 - 1 patches one tessellated frame numbers (fewer rings or "
-                  "vertices)");
+  void check(const FrameContext& frame) const override { validate(frame.context, frame.settings); }
+  // Validates and makes the pipeline for the settings' sample count now
+  // (the method stage of tube_stage.cpp forwards prepare, not check).
+  void prepare(const gpu::VulkanContext& context, const RenderSettings& settings) override {
+    validate(context, settings);
+    ensurePipeline(context, sampleCount(settings));
   }
   void resize(const gpu::VulkanContext& context, uint32_t, uint32_t) override { gpu::destroyBuffer(context, keys_); }
 
   void record(FrameContext& frame) override {
+    // Again here, before any command: the method-switching stage
+    // (tube_stage.cpp) does not forward check().
+    validate(frame.context, frame.settings);
     const uint32_t samples = sampleCount(frame.settings);
-    if (pipeline_.pipeline != VK_NULL_HANDLE && samples != samples_) {
+    ensurePipeline(frame.context, samples);
+    if (keys_.buffer && keys_samples_ != samples) {
       vkDeviceWaitIdle(frame.context.device());  // earlier frames may still use them
-      gpu::destroyGraphicsPipeline(frame.context, pipeline_);
       gpu::destroyBuffer(frame.context, keys_);
     }
-    samples_ = samples;
-    if (pipeline_.pipeline == VK_NULL_HANDLE) {
-      gpu::GraphicsPipelineDesc desc;
-      desc.vertex_shader = "tube_tess.vert";
-      desc.tess_control_shader = "tube_tess.tesc";
-      desc.tess_evaluation_shader = "tube_tess.tese";
-      desc.fragment_shader = "tube_tess.frag";
-      desc.topology = VK_PRIMITIVE_TOPOLOGY_PATCH_LIST;
-      desc.patch_control_points = 1;
-      desc.color_format = VK_FORMAT_UNDEFINED;
-      desc.push_constant_bytes = sizeof(shader::TubeTessPush);
-      desc.samples = VkSampleCountFlagBits(samples);
-      pipeline_ = gpu::createGraphicsPipeline(frame.context, desc);
-    }
     const uint32_t width = frame.targets.width, height = frame.targets.height;
-    if (!keys_.buffer)
+    if (!keys_.buffer) {
       keys_ = gpu::createBuffer(frame.context, frame.targets.pixels() * samples * sizeof(uint64_t),
                                 gpu::MemoryUse::DeviceLocal);
+      keys_samples_ = samples;
+    }
     // The previous frame's texels draw read the keys before they are cleared.
     gpu::recordBarrier(frame.cmd,
                        {VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, 0, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, 0});
@@ -126,6 +105,45 @@ class TubeTessStage final : public FrameStage {
   }
 
  private:
+  // Throws Error naming what the device lacks for these settings.
+  void validate(const gpu::VulkanContext& c, const RenderSettings& settings) const {
+    const auto refuse = [&](const std::string& what) {
+      throw Error("tubes: tessellated tubes need " + what + ", which " + c.info().name + " lacks");
+    };
+    if (!c.info().queue_has_graphics) refuse("a graphics queue");
+    if (!c.enabledFeatures().tessellationShader) refuse("tessellation shaders (tessellationShader)");
+    if (!c.enabledFeatures().fragmentStoresAndAtomics) refuse("fragmentStoresAndAtomics");
+    const uint32_t samples = sampleCount(settings);
+    if (samples == 0 || (c.limits().framebufferNoAttachmentsSampleCounts & samples) == 0)
+      refuse("tube-msaa " + std::to_string(settings.tube_msaa) +
+             " (samples per pixel without attachments, framebufferNoAttachmentsSampleCounts)");
+    const uint64_t patches = uint64_t(tubes_ ? tubes_->segment_count : 0) * patchesPerSegment(settings);
+    if (patches >= (uint64_t(1) << 32))
+      throw Error("tubes: " + std::to_string(tubes_->segment_count) + " segments of " +
+                  std::to_string(patchesPerSegment(settings)) +
+                  " patches each is more than the 2^32 - 1 patches one tessellated frame numbers (fewer rings or "
+                  "vertices)");
+  }
+  // The pipeline for `samples` (remade when the sample count changes).
+  void ensurePipeline(const gpu::VulkanContext& context, uint32_t samples) {
+    if (pipeline_.pipeline != VK_NULL_HANDLE && samples == samples_) return;
+    if (pipeline_.pipeline != VK_NULL_HANDLE) {
+      vkDeviceWaitIdle(context.device());  // earlier frames may still use it
+      gpu::destroyGraphicsPipeline(context, pipeline_);
+    }
+    gpu::GraphicsPipelineDesc desc;
+    desc.vertex_shader = "tube_tess.vert";
+    desc.tess_control_shader = "tube_tess.tesc";
+    desc.tess_evaluation_shader = "tube_tess.tese";
+    desc.fragment_shader = "tube_tess.frag";
+    desc.topology = VK_PRIMITIVE_TOPOLOGY_PATCH_LIST;
+    desc.patch_control_points = 1;
+    desc.color_format = VK_FORMAT_UNDEFINED;
+    desc.push_constant_bytes = sizeof(shader::TubeTessPush);
+    desc.samples = VkSampleCountFlagBits(samples);
+    pipeline_ = gpu::createGraphicsPipeline(context, desc);
+    samples_ = samples;
+  }
   // tube_msaa as a sample count (1, 4 or 8; 0 for anything else).
   static uint32_t sampleCount(const RenderSettings& s) {
     return s.tube_msaa == 1 || s.tube_msaa == 4 || s.tube_msaa == 8 ? uint32_t(s.tube_msaa) : 0u;
@@ -139,7 +157,8 @@ class TubeTessStage final : public FrameStage {
   TubeTessOptions options_;
   gpu::GraphicsPipeline pipeline_;  // made at the first frame with tubes
   gpu::Buffer keys_;                // uint64_t visibility key per pixel (per sample), row-major
-  uint32_t samples_ = 1;            // the pipeline's and the keys' samples
+  uint32_t samples_ = 1;            // the pipeline's samples
+  uint32_t keys_samples_ = 1;       // keys_'s keys per pixel
 };
 
 }  // namespace
