@@ -29,9 +29,12 @@
 #include "app/render_scene.h"
 #include "app/scene_cuts.h"
 #include "app/scene_filter.h"
+#include "app/tube_options.h"
 #include "core/error.h"
 #include "render/camera.h"
 #include "render/gpu/frame_renderer.h"
+#include "svo/gpu/gpu_svo.h"
+#include "tubes/gpu/gpu_tubes.h"
 
 namespace fibscope {
 namespace {
@@ -39,6 +42,16 @@ namespace {
 struct BenchOptions {
   RenderCliOptions render;
   std::string compare;
+  // Spline tubes (issue 15 item 5): --tubes draws them in every variant;
+  // --tube-compare M1,M2,... draws each variant once per tube method
+  // (compute, raycast, tess), all on the same frames.
+  TubeCliOptions tubes;
+  std::string tube_compare;
+  // SVO streamtubes (issue 16 item 5): --pipeline (or a --compare entry)
+  // svo-straight | svo-curved draws the fibers of --tubes (all by default)
+  // ray-traced from the octree over the compute pipeline's lines; --voxel
+  // as render's.
+  float voxel_mm = 0.0f;
   uint32_t frames = 316;
   double step_deg = 1.14;
   double elevation_deg = 0;
@@ -77,8 +90,11 @@ std::vector<OrbitFrame> orbitFrames(const BenchOptions& o) {
 
 struct Variant {
   std::string label;  // "compute/two-phase"
+  bool tubes = false;  // draws the tubes (--tubes; "none" in --tube-compare: not)
+  int svo = -1;        // the octree it traces: 0 straight, 1 curved; -1 none
   RenderSettings settings;
-  std::vector<double> gpu_ms, wall_ms, drawn_fraction, lod_fraction;
+  std::vector<double> gpu_ms, wall_ms, drawn_fraction, lod_fraction, tube_ms;
+  uint64_t tube_method_bytes = 0;  // the largest seen
   std::map<std::string, double> pass_ms_sum;
   std::vector<std::string> pass_order;
   uint64_t segments_drawn_sum = 0;
@@ -98,11 +114,27 @@ void countMissed(const std::vector<uint64_t>& reference, const std::vector<uint6
   v.changed_pixels.push_back(changed);
 }
 
-std::vector<Variant> variantsFrom(const BenchOptions& o) {
+constexpr std::string_view kSvoPipelines[] = {"svo-straight", "svo-curved"};
+
+int svoKind(std::string_view pipeline) {
+  for (int k = 0; k < 2; ++k)
+    if (pipeline == kSvoPipelines[k]) return k;
+  return -1;
+}
+
+std::vector<Variant> variantsFrom(BenchOptions o) {
+  // --pipeline svo-*: the compute pipeline's lines under the octree's tubes.
+  std::string base_spec;
+  if (const auto p = o.render.values.find("pipeline"); p != o.render.values.end() && svoKind(p->second) >= 0) {
+    base_spec = p->second;
+    p->second = "compute";
+  }
   const RenderSettings base = renderSettingsFrom(o.render);
   std::vector<std::string> specs;
   if (o.compare.empty()) {
-    specs.push_back(std::string(renderPipelineName(base.pipeline)) + "/" + std::string(cullingModeName(base.culling)));
+    specs.push_back(!base_spec.empty() ? base_spec
+                                       : std::string(renderPipelineName(base.pipeline)) + "/" +
+                                             std::string(cullingModeName(base.culling)));
   } else {
     size_t start = 0;
     while (start <= o.compare.size()) {
@@ -112,16 +144,52 @@ std::vector<Variant> variantsFrom(const BenchOptions& o) {
       start = comma + 1;
     }
   }
+  std::vector<std::string> tube_methods;
+  for (size_t start = 0; !o.tube_compare.empty() && start <= o.tube_compare.size();) {
+    const size_t comma = o.tube_compare.find(',', start);
+    tube_methods.push_back(o.tube_compare.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  bool svo = false;
+  for (const std::string& spec : specs) svo |= svoKind(spec.substr(0, spec.find('/'))) >= 0;
+  if (svo && o.tubes.requested() && !tube_methods.empty())
+    throw Error("--tube-compare: not with an svo pipeline (its tubes come from the octree)");
+  if (!tube_methods.empty() && !o.tubes.requested())
+    throw Error("--tube-compare: give the tubes to draw (--tubes FIBERS|all|filtered)");
   std::vector<Variant> variants;
   for (const std::string& spec : specs) {
     Variant v;
     v.settings = base;
     const size_t slash = spec.find('/');
+    if (const int kind = svoKind(spec.substr(0, slash)); kind >= 0) {
+      if (!tube_methods.empty()) throw Error("--tube-compare: not with " + spec + " (its tubes come from the octree)");
+      v.svo = kind;
+      v.settings.pipeline = RenderPipeline::Compute;
+      if (slash != std::string::npos) v.settings.culling = parseCullingMode(spec.substr(slash + 1));
+      v.label = spec.substr(0, slash) + "/" + std::string(cullingModeName(v.settings.culling));
+      variants.push_back(std::move(v));
+      continue;
+    }
     v.settings.pipeline = parseRenderPipeline(spec.substr(0, slash));
     if (slash != std::string::npos) v.settings.culling = parseCullingMode(spec.substr(slash + 1));
     v.label = std::string(renderPipelineName(v.settings.pipeline));
     if (drawsFiblets(v.settings.pipeline)) v.label += "/" + std::string(cullingModeName(v.settings.culling));
-    variants.push_back(std::move(v));
+    if (tube_methods.empty()) {
+      v.tubes = o.tubes.requested();
+      if (v.tubes) v.label += " tubes " + std::string(tubeMethodName(v.settings.tube_method));
+      variants.push_back(std::move(v));
+      continue;
+    }
+    for (const std::string& method : tube_methods) {
+      Variant t = v;
+      // "none": the same frames without tubes, so the wall time's
+      // difference is the tubes' where timestamps are not trusted.
+      t.tubes = method != "none";
+      if (t.tubes) t.settings.tube_method = parseTubeMethod(method);
+      t.label += " tubes " + (t.tubes ? std::string(tubeMethodName(t.settings.tube_method)) : std::string("none"));
+      variants.push_back(std::move(t));
+    }
   }
   return variants;
 }
@@ -145,6 +213,7 @@ void runBench(const BenchOptions& o) {
   if (!(std::fabs(o.step_deg) <= 360)) throw Error("--step: expected degrees in [-360, 360]");
   if (o.sample > o.frames) throw Error("--sample: expected at most --frames (" + std::to_string(o.frames) + ")");
   std::vector<Variant> variants = variantsFrom(o);
+  nlohmann::json out;
   const FilterCriteria criteria = criteriaFrom(o.render.criteria).criteria;  // bad specs before any work
   uint32_t width = 0, height = 0;
   parseFrameSize(o.render.size, width, height);
@@ -153,6 +222,35 @@ void runBench(const BenchOptions& o) {
   for (const Variant& v : variants) need_points |= !drawsFiblets(v.settings.pipeline);
 
   auto context = createRenderContext(o.render);
+  // The tubes' buffers and the octrees, read by the renderers' tube and
+  // SVO stages at each frame and released (by `tubes_owner`) before the
+  // renderers and the device.
+  GpuTubes tubes;
+  GpuSvo svos[2];
+  struct TubesOwner {
+    const gpu::VulkanContext& context;
+    GpuTubes& tubes;
+    GpuSvo* svos;
+    ~TubesOwner() {
+      for (int k = 0; k < 2; ++k) destroySvo(context, svos[k]);
+      destroyTubes(context, tubes);
+    }
+  };
+  std::optional<TubesOwner> tubes_owner;
+  bool svo_used[2] = {false, false};
+  for (const Variant& v : variants)
+    if (v.svo >= 0) svo_used[v.svo] = true;
+  TubeCliOptions tube_options = o.tubes;
+  if (svo_used[0] || svo_used[1]) {
+    // As render's: every fiber by default, and the fibers' own points
+    // (straight and curved tubes share their nodes).
+    if (tube_options.fibers.empty()) tube_options.fibers = "all";
+    if (tube_options.resample_tolerance_mm < 0.0f) tube_options.resample_tolerance_mm = 0.0f;
+  }
+  if (o.voxel_mm != 0.0f && !(svo_used[0] || svo_used[1]))
+    throw Error("--voxel: only with an svo-straight or svo-curved pipeline");
+  if (!(o.voxel_mm >= 0.0f) || !std::isfinite(o.voxel_mm))
+    throw Error("--voxel: expected a voxel size > 0 mm, got " + std::to_string(o.voxel_mm));
   SceneOptions scene_options;
   scene_options.path = o.render.input;
   scene_options.phantom_streamlines = o.render.phantom_streamlines;
@@ -174,11 +272,49 @@ void runBench(const BenchOptions& o) {
   cuts.apply(gpu_scene);
   std::vector<GpuScene> variant_scenes(variants.size(), gpu_scene);
   for (size_t i = 0; i < variants.size(); ++i) filter.apply(variant_scenes[i], variants[i].settings.pipeline);
+  TubeBuildStats tube_stats;
+  if (tube_options.requested()) {
+    std::vector<uint32_t> kept;
+    if (filter.active()) kept = filter.keptFibers();
+    const TubeModel model = loadTubeModel(o.render.input, o.render.phantom_streamlines, tube_options, &tube_stats,
+                                          filter.active() ? &kept : nullptr);
+    tubes = uploadTubes(*context, model);
+    tubes_owner.emplace(*context, tubes, svos);  // in place: a moved-from temporary would free them
+    for (int k = 0; k < 2; ++k) {
+      if (!svo_used[k]) continue;
+      SvoGpuBuildOptions build;
+      build.progress = true;
+      SvoGpuBuildStats svo_stats;
+      const SvoTree tree = buildSvoGpu(*context, model, tubes, chooseSvoGrid(model, o.voxel_mm, k == 1), build,
+                                       &svo_stats);
+      svos[k] = uploadSvo(*context, tree);
+      const std::string line = svoBuildSummary(model, tree, svo_stats);
+      if (!o.json) std::printf("%s: %s\n", std::string(kSvoPipelines[k]).c_str(), line.c_str());
+      out["svo"][std::string(kSvoPipelines[k])]["summary"] = line;
+      out["svo"][std::string(kSvoPipelines[k])]["node_bytes"] = tree.nodeBytes();
+      out["svo"][std::string(kSvoPipelines[k])]["decoration_bytes"] = tree.decorationBytes();
+      out["svo"][std::string(kSvoPipelines[k])]["leaves"] = tree.leaves;
+      out["svo"][std::string(kSvoPipelines[k])]["leaves_over_4"] = tree.leaves_over_4;
+      out["svo"][std::string(kSvoPipelines[k])]["build_s"] = svo_stats.voxelize_s + svo_stats.sort_s + svo_stats.tree_s;
+    }
+    out["tubes"]["fibers"] = tube_stats.tubes;
+    out["tubes"]["nodes"] = tube_stats.nodes;
+    out["tubes"]["input_points"] = tube_stats.input_points;
+    out["tubes"]["segments"] = tubes.segment_count;
+    // The tubes buffer of the seed's figure 3 (node and segment records);
+    // the methods' own per-frame buffers are not counted.
+    out["tubes"]["buffer_bytes"] = tubes.nodes.size + tubes.segments.size;
+  }
 
   // One renderer per variant: two-phase culling keeps the previous frame's
   // visibility, which must be its own.
   std::vector<std::unique_ptr<FrameRenderer>> renderers;
-  for (size_t i = 0; i < variants.size(); ++i) renderers.push_back(std::make_unique<FrameRenderer>(*context, width, height));
+  for (size_t i = 0; i < variants.size(); ++i)
+    renderers.push_back(std::make_unique<FrameRenderer>(
+        *context, width, height,
+        variants[i].svo >= 0 ? withSvoStage(standardFrameStages(), &svos[variants[i].svo], &tubes)
+        : variants[i].tubes  ? withTubeStage(standardFrameStages(), &tubes)
+                             : standardFrameStages()));
   // --count-missed: the unculled frame each culled compute variant is
   // compared with (the first compute variant's settings, culling off).
   // With LoD on, frustum culling with the same LoD instead: culling off
@@ -199,8 +335,6 @@ void runBench(const BenchOptions& o) {
     reference = std::make_unique<FrameRenderer>(*context, width, height);
   }
   uint64_t reference_covered = 0;
-
-  nlohmann::json out;
   // A constant distance for the whole orbit: the farthest of the snug fits
   // at 12 azimuths, so the tractogram fills the frame without leaving it.
   double distance = o.distance;
@@ -239,10 +373,14 @@ void runBench(const BenchOptions& o) {
           drawsFiblets(v.settings.pipeline)
               ? uint64_t(double(scene.segments) * double(stats.fiblets_drawn) / total_fiblets) + stats.fiblets_lod
               : scene.segments;
+      double tube_ms = 0;
       for (const PassTiming& p : stats.passes) {
+        if (isTubePass(p.name) || p.name == "svo trace") tube_ms += p.ms;
         if (!v.pass_ms_sum.count(p.name)) v.pass_order.push_back(p.name);
         v.pass_ms_sum[p.name] += p.ms;
       }
+      if (v.tubes || v.svo >= 0) v.tube_ms.push_back(tube_ms);
+      v.tube_method_bytes = std::max(v.tube_method_bytes, stats.tube_method_bytes);
     }
     // The reference after the variants: an occlusion variant's first frame
     // computes the datasets' exact fiblet spheres, which the frustum test
@@ -296,6 +434,11 @@ void runBench(const BenchOptions& o) {
                 scene.fiblets.block().fiblet_count, measured, o.step_deg);
     if (o.sample != 0) std::printf(" (sampled from an orbit of %u)", o.frames);
     std::printf(", %ux%u, %s\n", width, height, context->info().name.c_str());
+    if (o.tubes.requested())
+      std::printf("tubes: %llu fibers, %llu nodes (of %llu points), %u segments, tubes buffer %.2f MiB\n",
+                  static_cast<unsigned long long>(tube_stats.tubes), static_cast<unsigned long long>(tube_stats.nodes),
+                  static_cast<unsigned long long>(tube_stats.input_points), tubes.segment_count,
+                  double(tubes.nodes.size + tubes.segments.size) / double(1 << 20));
     if (cpu_device)
       std::printf("note: CPU device: ratios use wall time (per-pass timestamps of large dispatches are unreliable "
                   "on lavapipe)\n");
@@ -320,6 +463,12 @@ void runBench(const BenchOptions& o) {
       j["fiblets_drawn_fraction_per_frame"] = v.drawn_fraction;
     }
     j["segments_drawn_per_ms"] = segments_per_ms;
+    if (!v.tube_ms.empty()) {
+      j["tube_method"] = v.svo >= 0 ? kSvoPipelines[v.svo] : tubeMethodName(v.settings.tube_method);
+      j["tube_mean_ms"] = mean(v.tube_ms);
+      j["tube_median_ms"] = percentile(v.tube_ms, 50);
+      j["tube_method_bytes"] = v.tube_method_bytes;
+    }
     j["wall_median_ms"] = percentile(v.wall_ms, 50);
     j["median_ratio_to_first"] = base_median > 0 ? ratioTime(v) / base_median : 0.0;
     for (const std::string& name : v.pass_order) j["pass_mean_ms"][name] = v.pass_ms_sum[name] / double(measured);
@@ -345,6 +494,11 @@ void runBench(const BenchOptions& o) {
       std::printf(" %14.0f", segments_per_ms);
       if (variants.size() > 1) std::printf("   x%.2f of %s", base_median > 0 ? ratioTime(v) / base_median : 0.0,
                                            variants.front().label.c_str());
+      if (!v.tube_ms.empty())
+        std::printf("\n    tubes by %s: mean %.3f ms, median %.3f ms (their passes' GPU time), its buffers %.2f MiB",
+                    std::string(v.svo >= 0 ? kSvoPipelines[v.svo] : tubeMethodName(v.settings.tube_method)).c_str(),
+                    mean(v.tube_ms),
+                    percentile(v.tube_ms, 50), double(v.tube_method_bytes) / double(1 << 20));
       std::printf("\n    passes:");
       for (const std::string& name : v.pass_order) std::printf(" %s %.3f", name.c_str(), v.pass_ms_sum[name] / double(measured));
       std::printf(" (mean ms)\n");
@@ -370,7 +524,15 @@ void addBenchCommand(CLI::App& app) {
   addRenderCliOptions(cmd, o->render);
   cmd->add_option("--compare", o->compare,
                   "Pipelines drawn on the same frames, e.g. compute/two-phase,compute/coverage,compute/none,lines,"
-                  "raw-compute,geometry/frustum,tessellation/none; ratios are to the first");
+                  "raw-compute,geometry/frustum,tessellation/none,svo-straight,svo-curved; ratios are to the first");
+  addTubeCliOptions(cmd, o->tubes);
+  cmd->add_option("--tube-compare", o->tube_compare,
+                  "Tube methods drawn on the same frames, each with every --compare pipeline: none,compute,raycast,tess "
+                  "(with --tubes; none: without tubes, the baseline of the tubes' wall time); the seed's protocol: --frames 500 --step 0.72 --size 800x600|1200x768, far "
+                  "--distance 1, close --distance 0.3");
+  cmd->add_option("--voxel", o->voxel_mm,
+                  "Voxel size of the octree in mm for svo-straight and svo-curved (--pipeline or --compare; default: "
+                  "from the tube radius and the step)");
   cmd->add_option("--frames", o->frames, "Measured frames")->capture_default_str();
   cmd->add_option("--step", o->step_deg, "Orbit step per frame, degrees")->capture_default_str();
   cmd->add_option("--elevation", o->elevation_deg, "Orbit elevation, degrees")->capture_default_str();

@@ -216,11 +216,17 @@ void runRender(RenderCommandOptions o) {
     double tube_ms = 0;
     for (const PassTiming& p : stats.passes)
       if (isTubePass(p.name)) tube_ms += p.ms;
-    std::printf("tubes: %llu fibers, %llu nodes (of %llu points, within %.4f mm), %u segments, radius %.3f mm, "
+    const std::string radius = o.tubes.radius_from.empty()
+                                   ? "radius " + std::to_string(o.tubes.radius_mm) + " mm"
+                                   : "radius from " + o.tubes.radius_from + " (" + o.tubes.radius_range + " mm)";
+    std::printf("tubes: %llu fibers, %llu nodes (of %llu points, within %.4f mm), %u segments, %s, "
                 "drawn by %s in %.1f ms",
                 static_cast<unsigned long long>(tube_stats.tubes), static_cast<unsigned long long>(tube_stats.nodes),
                 static_cast<unsigned long long>(tube_stats.input_points), o.tubes.tolerance(), tubes.segment_count,
-                o.tubes.radius_mm, std::string(tubeMethodName(settings.tube_method)).c_str(), tube_ms);
+                radius.c_str(), std::string(tubeMethodName(settings.tube_method)).c_str(), tube_ms);
+    if (tube_stats.invalid_radii > 0)
+      std::printf(", %llu non-finite radius values drawn at the smallest radius",
+                  static_cast<unsigned long long>(tube_stats.invalid_radii));
     if (settings.tube_method == TubeMethod::Compute)
       std::printf(", %llu tiles overflowed", static_cast<unsigned long long>(stats.tube_tiles_overflowed));
     std::printf("\n");

@@ -7,9 +7,115 @@
 
 #include "app/open_input.h"
 #include "core/error.h"
+#include "io/reader.h"
 #include "phantom/phantom.h"
 
 namespace fibscope {
+namespace {
+
+// --tube-radius-from: the array's name and, for a .tsf, the file to attach.
+struct RadiusSource {
+  std::string array;
+  std::string tsf;
+};
+
+bool endsWith(const std::string& s, std::string_view end) {
+  return s.size() >= end.size() && s.compare(s.size() - end.size(), end.size(), end) == 0;
+}
+
+RadiusSource radiusSource(const std::string& path, const TubeCliOptions& o) {
+  RadiusSource r;
+  if (o.radius_from.empty()) return r;
+  if (!endsWith(o.radius_from, ".tsf")) {
+    r.array = o.radius_from;
+    return r;
+  }
+  if (!endsWith(path, ".tck"))
+    throw Error("--tube-radius-from " + o.radius_from + ": a .tsf file needs a .tck input");
+  r.tsf = o.radius_from;
+  // openTck names the array after the file's stem.
+  const size_t slash = r.tsf.find_last_of('/');
+  r.array = r.tsf.substr(slash == std::string::npos ? 0 : slash + 1);
+  r.array.resize(r.array.size() - 4);
+  return r;
+}
+
+// Appends streamline i of `chunk`'s array `name` (one component, per point
+// or per streamline) to `out`'s array of that name, which it makes at the
+// first call; `out` has just received the streamline's points. Throws
+// Error when the chunk has no such one-component array.
+void copyRadiusData(const Tractogram& chunk, size_t i, const std::string& name, Tractogram& out) {
+  const auto find = [&name](const std::vector<DataArray>& arrays) -> const DataArray* {
+    for (const DataArray& a : arrays)
+      if (a.name == name) return &a;
+    return nullptr;
+  };
+  const auto target = [&name](std::vector<DataArray>& arrays) -> DataArray& {
+    for (DataArray& a : arrays)
+      if (a.name == name) return a;
+    arrays.push_back(DataArray{name, 1, "float32", {}});
+    return arrays.back();
+  };
+  const auto oneComponent = [&name](const DataArray& a) {
+    if (a.components != 1)
+      throw Error("--tube-radius-from " + name + ": the array has " + std::to_string(a.components) +
+                  " components; a radius needs 1");
+  };
+  if (const DataArray* a = find(chunk.per_point)) {
+    oneComponent(*a);
+    DataArray& to = target(out.per_point);
+    to.values.insert(to.values.end(), a->values.begin() + ptrdiff_t(chunk.offsets[i]),
+                     a->values.begin() + ptrdiff_t(chunk.offsets[i + 1]));
+  } else if (const DataArray* b = find(chunk.per_streamline)) {
+    oneComponent(*b);
+    target(out.per_streamline).values.push_back(b->values[i]);
+  } else {
+    std::string have;
+    for (const auto* arrays : {&chunk.per_point, &chunk.per_streamline})
+      for (const DataArray& a : *arrays) have += (have.empty() ? "" : ", ") + a.name;
+    throw Error("--tube-radius-from " + name + ": the input has no array of that name (it has: " +
+                (have.empty() ? std::string("none") : have) + ")");
+  }
+}
+
+// "A,B" as two finite numbers with A <= B; Error naming the option.
+void parsePair(const std::string& text, const char* option, float& a, float& b) {
+  const size_t comma = text.find(',');
+  const auto number = [&](std::string_view s, float& v) {
+    const auto r = std::from_chars(s.data(), s.data() + s.size(), v);
+    return !s.empty() && r.ec == std::errc() && r.ptr == s.data() + s.size() && std::isfinite(v);
+  };
+  if (comma == std::string::npos || !number(std::string_view(text).substr(0, comma), a) ||
+      !number(std::string_view(text).substr(comma + 1), b) || b < a)
+    throw Error(std::string(option) + ": expected LO,HI with LO <= HI, got '" + text + "'");
+}
+
+// The radius of `selected`'s array `name` (copied there by copyRadiusData)
+// mapped from --tube-radius-data onto --tube-radius-range.
+TubeRadius dataRadius(const Tractogram& selected, const std::string& name, const TubeCliOptions& o) {
+  TubeRadius r;
+  r.array = name;
+  const DataArray* a = nullptr;
+  for (const DataArray& d : selected.per_point)
+    if (d.name == name) a = &d, r.source = TubeRadius::Source::PerPoint;
+  for (const DataArray& d : selected.per_streamline)
+    if (!a && d.name == name) a = &d, r.source = TubeRadius::Source::PerFiber;
+  if (!a) throw Error("--tube-radius-from " + name + ": the input has no array of that name");
+  parsePair(o.radius_range, "--tube-radius-range", r.radius_min, r.radius_max);
+  if (!(r.radius_min > 0.0f)) throw Error("--tube-radius-range: the radii must be > 0 mm, got '" + o.radius_range + "'");
+  if (!o.radius_data.empty()) {
+    parsePair(o.radius_data, "--tube-radius-data", r.data_min, r.data_max);
+    return r;
+  }
+  r.data_min = INFINITY;
+  r.data_max = -INFINITY;
+  for (float v : a->values)
+    if (std::isfinite(v)) r.data_min = std::min(r.data_min, v), r.data_max = std::max(r.data_max, v);
+  if (r.data_min > r.data_max) r.data_min = r.data_max = 0.0f;  // no finite value: every radius radius_min
+  return r;
+}
+
+}  // namespace
 
 void addTubeCliOptions(CLI::App* cmd, TubeCliOptions& o) {
   cmd->add_option(
@@ -18,6 +124,13 @@ void addTubeCliOptions(CLI::App* cmd, TubeCliOptions& o) {
          "indices and ranges (0-99,512)")
       ->each([&o](const std::string&) { o.given = true; });
   cmd->add_option("--tube-radius", o.radius_mm, "Tube radius in mm (default 0.5)");
+  cmd->add_option("--tube-radius-from", o.radius_from,
+                  "Radius from the data: a per-point or per-streamline array of the input (trk scalars or "
+                  "properties, TRX dpv or dps), or a .tsf file of a .tck input");
+  cmd->add_option("--tube-radius-data", o.radius_data,
+                  "LO,HI: the data values mapped onto --tube-radius-range (default: the selected fibers' range)");
+  cmd->add_option("--tube-radius-range", o.radius_range, "MIN,MAX: the radii in mm the data range maps to")
+      ->capture_default_str();
   cmd->add_flag("--tubes-dim-rest", o.dim_rest,
                 "Make the tube fibers the selection: their lines highlighted, the others dimmed (--dim)");
   cmd->add_option(
@@ -73,7 +186,12 @@ TubeModel loadTubeModel(const std::string& path, uint64_t phantom_streamlines, c
     throw Error("--tube-tolerance: expected a distance >= 0 mm, got " + std::to_string(options.resample_tolerance_mm));
   PhantomOptions phantom;
   phantom.streamlines = phantom_streamlines;
-  const auto open = [&]() { return path.empty() ? openPhantom(phantom) : openInput(path); };
+  const RadiusSource radius = radiusSource(path, options);
+  const auto open = [&]() {
+    if (path.empty()) return openPhantom(phantom);
+    if (!radius.tsf.empty()) return openTck(path, {radius.tsf});
+    return openInput(path);
+  };
   // The count first: "all" and the range check need it (a header may not
   // state it, so count by reading when it does not).
   uint64_t count = 0;
@@ -111,6 +229,7 @@ TubeModel loadTubeModel(const std::string& path, uint64_t phantom_streamlines, c
       for (size_t i = 0; i < chunk.streamlineCount() && next < sorted.size(); ++i)
         if (first + i == sorted[next]) {
           selected.addStreamline(chunk.point(chunk.offsets[i]), chunk.pointsIn(i));
+          if (!radius.array.empty()) copyRadiusData(chunk, i, radius.array, selected);
           ++next;
         }
       first += chunk.streamlineCount();
@@ -127,11 +246,12 @@ TubeModel loadTubeModel(const std::string& path, uint64_t phantom_streamlines, c
     }
   const float extent = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                                  (hi[2] - lo[2]) * (hi[2] - lo[2]));
-  if (selected.pointCount() > 1 && options.radius_mm > extent)
+  if (radius.array.empty() && selected.pointCount() > 1 && options.radius_mm > extent)
     throw Error("--tube-radius: " + std::to_string(options.radius_mm) +
                 " mm is larger than the selected fibers' extent (" + std::to_string(extent) + " mm across)");
   TubeBuildOptions build;
   build.radius.radius = options.radius_mm;
+  if (!radius.array.empty()) build.radius = dataRadius(selected, radius.array, options);
   build.resample_tolerance = options.tolerance();
   // In the order given: the position of each wanted fiber among the sorted.
   build.fibers.reserve(wanted.size());

@@ -1,6 +1,7 @@
-// Spline tubes on the command line (issue 15 item 5, the part that exists:
-// compute ray casting): `--tubes FIBERS|all` with `--tube-radius MM` draws
-// the listed fibers as ray-cast tubes over the lines, depth-composited.
+// Spline tubes on the command line (issue 15 item 5): `--tubes
+// FIBERS|all|filtered` with `--tube-radius MM` (or a radius from the data,
+// --tube-radius-from) draws the listed fibers as tubes over the lines,
+// depth-composited, by the method of the setting --tube-method.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -17,6 +18,15 @@ namespace fibscope {
 struct TubeCliOptions {
   std::string fibers;  // "" none, "all", "filtered" (the fiber filter's kept ones), or indices and ranges: "0-99,512"
   float radius_mm = 0.5f;
+  // The radius from the file's data (issue 15 item 1): a per-point array
+  // (trk scalars, TRX dpv) or, failing that, a per-streamline one (trk
+  // properties, TRX dps) of that name, or a .tsf file beside a .tck input
+  // (its stem names the array); its values mapped linearly from
+  // radius_data ("LO,HI"; empty: the selected fibers' finite min and max)
+  // onto radius_range ("MIN,MAX" mm), clamped.
+  std::string radius_from;
+  std::string radius_data;
+  std::string radius_range = "0.2,1";
   float resample_tolerance_mm = -1.0f;  // < 0: a twentieth of the radius
   bool dim_rest = false;                // the tube fibers as the selection: highlighted, the rest dimmed
   bool given = false;                   // --tubes was on the command line (even as an empty string)

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <functional>
 
 #include "codec/fbl_codec.h"
 #include "codec/fbl_reader.h"
@@ -66,10 +67,9 @@ std::vector<uint32_t> FiberSelection::bitWords(uint64_t fiber_count) const {
   return words;
 }
 
-void exportFibers(const FblFile& file, std::span<const uint32_t> fibers, const std::string& tck_path,
-                  bool overwrite) {
+void decodeFibers(const FblFile& file, std::span<const uint32_t> fibers, size_t chunk_points,
+                  const std::function<void(const Tractogram&)>& sink) {
   const std::string& path = file.path();
-  if (fibers.empty()) fail(tck_path, "no fibers to export (the selection is empty)");
   const FblHeaderFields& h = file.header();
   const CodecParams params = codecParamsFromFbl(h, path);
   const FibletDecoder decoder(params);
@@ -126,11 +126,6 @@ void exportFibers(const FblFile& file, std::span<const uint32_t> fibers, const s
     checkFiber(f);
   }
 
-  TractogramHeader like;
-  like.format = "tck";
-  WriterOptions options;
-  options.overwrite = overwrite;
-  const std::unique_ptr<TractogramWriter> writer = createTckWriter(tck_path, like, options);
   Tractogram chunk;
   std::vector<float> xyz_world;
   std::array<float, 3 * shader::kFibletMaxPoints> xyz;
@@ -147,12 +142,33 @@ void exportFibers(const FblFile& file, std::span<const uint32_t> fibers, const s
       }
     }
     chunk.addStreamline(xyz_world.data(), xyz_world.size() / 3);
-    if (chunk.pointCount() >= kExportChunkPoints) {
-      writer->write(chunk);
+    if (chunk.pointCount() >= chunk_points) {
+      sink(chunk);
       chunk.clear();
     }
   }
-  if (chunk.streamlineCount() > 0) writer->write(chunk);
+  if (chunk.streamlineCount() > 0) sink(chunk);
+}
+
+Tractogram decodeFibers(const FblFile& file, std::span<const uint32_t> fibers) {
+  Tractogram all;
+  decodeFibers(file, fibers, SIZE_MAX, [&all](const Tractogram& chunk) { all = chunk; });
+  return all;
+}
+
+void exportFibers(const FblFile& file, std::span<const uint32_t> fibers, const std::string& tck_path,
+                  bool overwrite) {
+  if (fibers.empty()) fail(tck_path, "no fibers to export (the selection is empty)");
+  TractogramHeader like;
+  like.format = "tck";
+  WriterOptions options;
+  options.overwrite = overwrite;
+  // The checks run before the first chunk, so a bad id leaves no file.
+  std::unique_ptr<TractogramWriter> writer;
+  decodeFibers(file, fibers, kExportChunkPoints, [&](const Tractogram& chunk) {
+    if (!writer) writer = createTckWriter(tck_path, like, options);
+    writer->write(chunk);
+  });
   writer->finish();
 }
 

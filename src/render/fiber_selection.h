@@ -4,12 +4,14 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <span>
 #include <string>
 #include <vector>
 
 #include "codec/fbl_file.h"
+#include "core/tractogram.h"
 
 namespace fibscope {
 
@@ -41,6 +43,16 @@ class FiberSelection {
   std::vector<uint32_t> fibers_;
   uint64_t revision_ = 0;
 };
+
+// The fibers `fibers` (in that order, duplicates as often as listed) of the
+// .fbl `file`, decoded as exportFibers writes them (world mm, equal to
+// `fibscope decompress`'s points), handed to `sink` in chunks of at least
+// `chunk_points` points (the last may hold fewer) after every id and fiber
+// was checked. Throws Error as exportFibers. Safe on untrusted files.
+void decodeFibers(const FblFile& file, std::span<const uint32_t> fibers, size_t chunk_points,
+                  const std::function<void(const Tractogram&)>& sink);
+// All of them in one tractogram (selections, tubes).
+Tractogram decodeFibers(const FblFile& file, std::span<const uint32_t> fibers);
 
 // Writes the fibers `fibers` (in that order, duplicates written as often as
 // listed) of the .fbl `file` to the .tck `tck_path`: their fiblets decoded

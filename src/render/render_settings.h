@@ -238,6 +238,9 @@ struct FrameStats {
   // Spline tubes' compute ray casting (src/tubes/gpu): screen tiles whose
   // sub-segment list overflowed, each of which tested every sub-segment.
   uint64_t tube_tiles_overflowed = 0;
+  // The tube method's own device buffers at this frame's size (tile lists,
+  // visibility keys, ...), beside the tubes buffer all methods share.
+  uint64_t tube_method_bytes = 0;
 };
 
 }  // namespace fibscope

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "app/tube_options.h"
@@ -83,6 +84,33 @@ TEST_F(GpuCliTubes, filteredTubesAreTheFibersTheFilterKeeps) {
       runFibscope("render --phantom-streamlines 50 --size 64x48 --tubes filtered -o " + dir_.file("n.png"));
   EXPECT_EQ(none.exit_code, 2);
   EXPECT_NE(none.output.find("--tubes filtered"), std::string::npos) << none.output;
+}
+
+// bench --tubes --tube-compare: every method on the same frames, their
+// tube passes timed per variant, "none" the same frames without tubes.
+TEST_F(GpuCliTubes, benchDrawsEachTubeMethodOnTheSameFrames) {
+  const auto r = runFibscope(
+      "bench --validate --phantom-streamlines 60 --size 80x60 --frames 2 --warmup 0 --tubes 0-9 --tube-radius 0.8 "
+      "--tube-compare none,compute,raycast --json");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json j = nlohmann::json::parse(r.output.substr(r.output.find('{')));
+  EXPECT_EQ(j["tubes"]["fibers"], 10);
+  EXPECT_GT(j["tubes"]["segments"].get<uint64_t>(), 10u);
+  EXPECT_EQ(j["tubes"]["buffer_bytes"].get<uint64_t>(),
+            48 * j["tubes"]["nodes"].get<uint64_t>() + 16 * j["tubes"]["segments"].get<uint64_t>());
+  ASSERT_EQ(j["results"].size(), 3u);
+  EXPECT_FALSE(j["results"][0].contains("tube_method"));
+  EXPECT_EQ(j["results"][1]["tube_method"], "compute");
+  EXPECT_EQ(j["results"][2]["tube_method"], "raycast");
+  EXPECT_TRUE(j["results"][1]["pass_mean_ms"].contains("tube raycast")) << j["results"][1].dump();
+  EXPECT_TRUE(j["results"][2]["pass_mean_ms"].contains("tube boxes")) << j["results"][2].dump();
+  EXPECT_FALSE(j["results"][0]["pass_mean_ms"].contains("tube raycast"));
+  for (const auto& [args, want] : std::vector<std::pair<std::string, std::string>>{
+           {" --tube-compare compute", "--tube-compare"}, {" --tubes 0-3 --tube-compare compute,cubes", "cubes"}}) {
+    const auto bad = runFibscope("bench --phantom-streamlines 40 --size 32x24 --frames 1" + args);
+    EXPECT_EQ(bad.exit_code, 2) << args << ": " << bad.output;
+    EXPECT_NE(bad.output.find(want), std::string::npos) << args << ": " << bad.output;
+  }
 }
 
 TEST_F(GpuCliTubes, badTubeOptionsAreOneLineErrors) {

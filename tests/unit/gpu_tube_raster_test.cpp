@@ -212,6 +212,37 @@ TEST_F(GpuTubeRaster, fragmentAndComputeVariantsWriteTheSameTexelsOnAOnePointSph
   EXPECT_LE(a.max_depth_mm, 2e-4) << a.summary();
 }
 
+// The tube stage (tubeStage: the method by RenderSettings::tube_method,
+// frame to frame in one renderer) draws what each method's own stage
+// draws, texel for texel, and switching back gives the first frame again.
+TEST_F(GpuTubeRaster, theTubeStageSwitchesMethodsFrameToFrameAsTheirOwnStagesDraw) {
+  const test::TubeScene scene = test::tubeScenes().front();  // a copy: tubeScenes() returns by value
+  const TubeModel model = buildTubes(scene.tractogram, scene.options);
+  const Camera camera = test::tubeSceneCameras(scene, 96, 72).front();
+  const std::vector<shader::SurfaceTexel> compute = cast(model, camera, tubeRaycastStage);
+  const std::vector<shader::SurfaceTexel> raster = cast(model, camera, tubeRasterRaycastStage);
+  GpuTubes tubes = uploadTubes(context(), model);
+  try {
+    FrameRenderer renderer(context(), camera.width, camera.height, {makeSetupStage, tubeStage(&tubes)});
+    const auto frame = [&](TubeMethod method, const char* pass) {
+      RenderSettings settings;
+      settings.tube_method = method;
+      const FrameStats stats = renderer.render(camera, settings, GpuScene());
+      bool timed = false;
+      for (const PassTiming& p : stats.passes) timed |= p.name == pass;
+      EXPECT_TRUE(timed) << pass;
+      return downloadSurface(context(), renderer.targets());
+    };
+    expectSameTexels(compareVariants(frame(TubeMethod::Compute, "tube raycast"), compute), "compute");
+    expectSameTexels(compareVariants(frame(TubeMethod::Raycast, "tube boxes"), raster), "raycast");
+    expectSameTexels(compareVariants(frame(TubeMethod::Compute, "tube raycast"), compute), "compute again");
+  } catch (...) {
+    destroyTubes(context(), tubes);
+    throw;
+  }
+  destroyTubes(context(), tubes);
+}
+
 // 300 short tubes piled in the same few tiles (the compute test's scene):
 // over kTubeTileCapacity sub-segments a tile, where the compute caster
 // tests every sub-segment; the boxes need no lists.
@@ -240,24 +271,6 @@ TEST_F(GpuTubeRaster, fragmentAndComputeVariantsAgreeWhereTileListsOverflow) {
   EXPECT_LE(a.fiber_mismatch, a.both / 50) << a.summary();  // tubes overlapping within float depth
 }
 
-// `stages` with the fragment-shader tube stage before the surface merge:
-// withTubeStage's list with its compute stage swapped for it.
-FrameStageList withRasterTubeStage(const GpuTubes* tubes) {
-  FrameStageList stages = withTubeStage(standardFrameStages(), tubes);
-  const size_t plain = standardFrameStages().size();
-  // withTubeStage's stage is the lambda just before the surface merge.
-  using Factory = std::unique_ptr<FrameStage> (*)(const gpu::VulkanContext&);
-  for (size_t i = 0; i + 1 < stages.size(); ++i) {
-    const Factory* next = stages[i + 1].target<Factory>();
-    if (!stages[i].target<Factory>() && next && *next == &makeSurfaceMergeStage) {
-      stages[i] = tubeRasterRaycastStage(tubes);
-      break;
-    }
-  }
-  EXPECT_EQ(stages.size(), plain + 1);
-  return stages;
-}
-
 // As the compute variant's test (tube_test_scenes.h's lines-and-tubes
 // scene, seen from +z): tube pixels where the reference tube is nearer
 // than the reference lines, line pixels where the lines are nearer.
@@ -284,13 +297,14 @@ TEST_F(GpuTubeRaster, tubesAndLinesOccludeEachOtherBothWaysAsTheReferences) {
   const GpuRawTractogram raw = GpuRawTractogram::upload(context(), setup.lines, "lines");
   GpuTubes tubes = uploadTubes(context(), model);
   try {
-    FrameRenderer renderer(context(), w, h, withRasterTubeStage(&tubes));
+    FrameRenderer renderer(context(), w, h, withTubeStage(standardFrameStages(), &tubes));
     const GpuScene scene(&upload.dataset, &raw);
     for (const RenderPipeline pipeline : {RenderPipeline::Compute, RenderPipeline::RawCompute}) {
       SCOPED_TRACE(std::string(renderPipelineName(pipeline)));
       RenderSettings settings;
       settings.pipeline = pipeline;
       settings.line_width_px = 2.0f;
+      settings.tube_method = TubeMethod::Raycast;  // the tube stage draws by the frame's method
       const FrameStats stats = renderer.render(camera, settings, scene);
       const auto texels = downloadGBuffer(context(), renderer.targets());
       std::vector<uint8_t> got_tube, got_line;

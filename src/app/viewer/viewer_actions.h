@@ -115,6 +115,13 @@ struct QuitAction {};
 struct AnatomyAction {
   std::string path;
 };
+// Which fibers the viewer draws as spline tubes (TubesInfo; viewer_tubes.h):
+// the selection's, the dissection's kept ones, both or none; radius_mm
+// > 0 also sets the radius.
+struct TubesAction {
+  bool selection = false, filtered = false;
+  float radius_mm = 0;
+};
 // Moves the active slice (RenderSettings::active_slice) by this many
 // voxels, within the volume (Page Up / Page Down).
 struct SliceStepAction {
@@ -146,7 +153,7 @@ using ViewerAction = std::variant<OrbitAction, PanAction, DollyAction, ViewActio
                                   ExportSelectionAction, ExpectSelectedAction, DissectionAction, RoiSetFileAction,
                                   ExportKeptAction, ExpectKeptAction, RoiPlaceAction, RoiDragAction, RoiResizeAction,
                                   ResizeAction, QuitAction, AnatomyAction, SliceStepAction, BundleAction,
-                                  CancelBundleAction, ShowOnlyModelAction, SaveModelAction>;
+                                  CancelBundleAction, ShowOnlyModelAction, SaveModelAction, TubesAction>;
 
 // Sets one RenderSettings field from text, as `set KEY VALUE` in a script:
 // KEY is a setting's name in render/settings_table.h (the command line's

@@ -30,6 +30,7 @@
 #include "app/viewer/viewer_input.h"
 #include "app/viewer/viewer_script.h"
 #include "app/viewer/viewer_selection.h"
+#include "app/viewer/viewer_tubes.h"
 #include "app/viewer/viewer_state.h"
 #include "app/viewer/viewer_ui.h"
 #include "app/viewer/viewer_window.h"
@@ -195,6 +196,10 @@ class ViewerApp {
   // Picking and the selection (viewer_selection.h), between frames.
   void syncSelection(const FrameScene& scene);
   void syncSelection() { syncSelection(currentScene()); }
+  // The tubes panel's fibers of `scene` as tubes (viewer_tubes.h), between frames.
+  void syncTubes(const FrameScene& scene);
+  // The frame stages of every renderer: the standard ones and the tubes.
+  FrameStageList frameStages() const { return withTubeStage(standardFrameStages(), tubes_->gpu()); }
   void pickAt(const PickAction& pick);
   GpuScene withSelection(const FrameScene& scene) const;
   // An anatomy action (viewer_anatomy.h), between frames; `at_start`: the
@@ -225,6 +230,9 @@ class ViewerApp {
   std::vector<uint64_t> framed_ids_;  // the models loaded when the camera was last framed
   std::vector<uint64_t> scalar_range_ids_;  // the visible models the scalar range was fitted to
   std::unique_ptr<ViewerSelection> selection_;
+  // The spline tubes (viewer_tubes.h): made before the renderers, whose
+  // tube stage reads its buffers at every frame, and released after them.
+  std::unique_ptr<ViewerTubes> tubes_;
   std::unique_ptr<GpuSceneFiberLengths> scene_lengths_;  // the scalar colour mode's per-fiber values
   std::unique_ptr<ViewerDissection> dissection_;
   std::unique_ptr<ViewerCuts> cuts_;  // the dissection's cut meshes on the GPU
@@ -327,7 +335,8 @@ void ViewerApp::createFrameObjects() {
   }
   presentation_ = createPresentation(*context_, width, height);
   imgui_ = std::make_unique<ImGuiLayer>(*context_, presentation_.render_pass, window_ ? window_->handle() : nullptr);
-  renderer_ = std::make_unique<FrameRenderer>(*context_, width, height);
+  tubes_ = std::make_unique<ViewerTubes>(*context_);
+  renderer_ = std::make_unique<FrameRenderer>(*context_, width, height, frameStages());
   selection_ = std::make_unique<ViewerSelection>(*context_);
   scene_lengths_ = std::make_unique<GpuSceneFiberLengths>(*context_);
   dissection_ = std::make_unique<ViewerDissection>(*context_);
@@ -398,6 +407,7 @@ void ViewerApp::release() {
   if (upscale_ready_) destroyUpscalePass(*context_, upscale_);
   upscale_ready_ = false;
   renderer_.reset();
+  tubes_.reset();  // after every renderer (their tube stage reads its buffers)
   selection_.reset();
   scene_lengths_.reset();
   dissection_.reset();  // cancels an export
@@ -844,6 +854,11 @@ void ViewerApp::apply(const ViewerAction& action) {
           applyDissection(action);
         } else if constexpr (std::is_same_v<A, QuitAction>) {
           quit_ = true;
+        } else if constexpr (std::is_same_v<A, TubesAction>) {
+          state_.tubes.selection = a.selection;
+          state_.tubes.filtered = a.filtered;
+          if (a.radius_mm > 0) state_.tubes.radius_mm = a.radius_mm;
+          if (state_.tubes.wanted()) state_.show_tubes = true;  // as the panel's switches open it
         } else if constexpr (std::is_same_v<A, AnatomyAction>) {
           loadAnatomy(a.path);
         } else if constexpr (std::is_same_v<A, SliceStepAction>) {
@@ -1158,7 +1173,8 @@ void ViewerApp::takeScreenshot(const ScreenshotAction& shot) {
     controller_.finishAnimation();
     const FrameScene scene = currentScene();
     if (scene.empty()) throw Error("screenshot: no visible model to draw");
-    if (!shot_renderer_) shot_renderer_ = std::make_unique<FrameRenderer>(*context_, shot.width, shot.height);
+    if (!shot_renderer_)
+      shot_renderer_ = std::make_unique<FrameRenderer>(*context_, shot.width, shot.height, frameStages());
     shot_renderer_->resize(shot.width, shot.height);
     const Camera camera = anatomy_.inView(controller_.camera(shot.width, shot.height));
     syncSelection(scene);
@@ -1193,6 +1209,56 @@ void ViewerApp::syncSelection(const FrameScene& scene) {
     selection_->sync(models, scene.layout.fibers, activeModelId(), state_.selection);
   } catch (const Error& e) {
     state_.status = e.what();
+  }
+}
+
+void ViewerApp::syncTubes(const FrameScene& scene) {
+  TubesInfo& info = state_.tubes;
+  // What the tubes are of: the wanted sets, their radius and tolerance,
+  // the scene's models and numbering, and the selection's or the kept
+  // bits' state (read only when they change).
+  std::string key;
+  if (info.wanted() && !scene.empty()) {
+    key = std::to_string(info.selection) + std::to_string(info.filtered) + "|" + std::to_string(info.radius_mm) +
+          "|" + std::to_string(info.tolerance_mm) + "|";
+    for (size_t k = 0; k < scene.models.size(); ++k)
+      key += std::to_string(scenes_[size_t(scene.models[k])]->id) + ":" +
+             std::to_string(scene.layout.entries[k].fiber_base) + ",";
+    if (info.selection)
+      for (const SelectedEntry& e : selection_->entries()) key += std::to_string(e.model) + "." + std::to_string(e.fiber) + ",";
+    if (info.filtered) key += "|" + dissection_->keptKey();
+  }
+  const auto sources = [&]() {
+    std::vector<ViewerTubeSource> out(scene.models.size());
+    std::vector<std::vector<bool>> taken(scene.models.size());
+    for (size_t k = 0; k < scene.models.size(); ++k) {
+      const ViewerModel& m = *scenes_[size_t(scene.models[k])];
+      out[k].fbl = &m.data->fbl;
+      out[k].fiber_base = scene.layout.entries[k].fiber_base;
+      taken[k].assign(m.data->streamlines, false);
+    }
+    const auto add = [&](size_t k, uint32_t fiber) {
+      if (fiber < taken[k].size() && !taken[k][fiber]) {
+        taken[k][fiber] = true;
+        out[k].fibers.push_back(fiber);
+      }
+    };
+    if (info.selection)
+      for (const SelectedEntry& e : selection_->entries())
+        for (size_t k = 0; k < scene.models.size(); ++k)
+          if (scenes_[size_t(scene.models[k])]->id == e.model) add(k, e.fiber);
+    if (info.filtered) {
+      const std::optional<std::vector<uint32_t>> kept = dissection_->keptSceneFibers(state_.dissection);
+      if (!kept) throw Error("tubes: no dissection criteria to take the kept fibers of");
+      for (const uint32_t global : *kept)
+        if (const std::optional<SceneFiber> at = locateSceneFiber(scene.layout, global)) add(at->dataset, at->fiber);
+    }
+    return out;
+  };
+  try {
+    tubes_->update(key, sources, info);
+  } catch (const Error& e) {
+    info.message = e.what();
   }
 }
 
@@ -1296,7 +1362,8 @@ void ViewerApp::recordFrame(VkCommandBuffer cmd, uint32_t width, uint32_t height
       coarse_divisor_ = coarseDivisor(coarse_divisor_, last_coarse_frame_ms_);
       const uint32_t half_width = std::max(1u, width / coarse_divisor_),
                      half_height = std::max(1u, height / coarse_divisor_);
-      if (!coarse_renderer_) coarse_renderer_ = std::make_unique<FrameRenderer>(*context_, half_width, half_height);
+      if (!coarse_renderer_)
+        coarse_renderer_ = std::make_unique<FrameRenderer>(*context_, half_width, half_height, frameStages());
       else if (coarse_renderer_->targets().width != half_width || coarse_renderer_->targets().height != half_height)
         coarse_renderer_->resize(half_width, half_height);
       if (!upscale_ready_) {
@@ -1375,6 +1442,7 @@ bool ViewerApp::drawFrame(uint32_t width, uint32_t height, double dt) {
   const Camera camera = anatomy_.inView(controller_.camera(width, height));
   const FrameScene scene = currentScene();
   syncSelection(scene);  // the highlight's bits for this frame (nothing in flight now)
+  syncTubes(scene);
 
   VK_CHECK(vkResetCommandBuffer(cmd_, 0));
   VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
@@ -1464,7 +1532,8 @@ void ViewerApp::run() {
         for (const ViewerAction& action : input_.map(event, imgui_->wantsMouse(), imgui_->wantsKeyboard()))
           apply(action);
     if (!starting)
-      for (const ViewerAction& action : script_.nextFrame(loader_->busy() || anatomy_.loading(), dissection_->exporting(),
+      for (const ViewerAction& action : script_.nextFrame(loader_->busy() || anatomy_.loading() || state_.tubes.building,
+                                                                  dissection_->exporting(),
                                                                   state_.bundling.running)) apply(action);
     if (!starting && options_.orbit_deg_per_frame != 0)
       controller_.rotate(options_.orbit_deg_per_frame / OrbitController::kDegreesPerPixel, 0);

@@ -84,6 +84,13 @@ class ViewerDissection {
   // dimming, selection_bits (the kept fibers drawn as the selection) and
   // true. False and nothing set without criteria.
   bool apply(const DissectionState& state, GpuScene& scene, bool baseline) const;
+  // The scene-global ids of the fibers the last evaluation kept over the
+  // fiblet scene (read back from the GPU: between frames); nullopt without
+  // criteria, after a failed update or when the bits are a baseline's.
+  std::optional<std::vector<uint32_t>> keptSceneFibers(const DissectionState& state) const;
+  // Changes whenever the kept bits may have (the scene or the criteria
+  // they were evaluated for).
+  std::string keptKey() const { return scene_key_ + "|" + criteria_key_ + (failed_ ? "|failed" : ""); }
 
   // Starts writing the fibers the state's criteria keep of `source` to
   // `path` (.tck, .trk, .trx; replaced if it exists) on a thread of its

@@ -271,6 +271,20 @@ std::variant<ViewerAction, WaitFrames, WaitLoaded, WaitExported, WaitBundled> pa
       throw Error("resize: expected 16 to 16384 pixels each, got " + std::string(w[1]) + " x " + std::string(w[2]));
     return ViewerAction{ResizeAction{uint32_t(width), uint32_t(height)}};
   }
+  if (name == "tubes") {
+    expectArguments(w, 1, 2, "tubes selection|filtered|both|off [RADIUS_MM]");
+    TubesAction t;
+    const std::string_view which = w[1];
+    if (which != "selection" && which != "filtered" && which != "both" && which != "off")
+      throw Error("tubes: expected selection, filtered, both or off, got '" + std::string(which) + "'");
+    t.selection = which == "selection" || which == "both";
+    t.filtered = which == "filtered" || which == "both";
+    if (w.size() == 3) {
+      t.radius_mm = float(number(w[2], "RADIUS_MM"));
+      if (!(t.radius_mm > 0.0f)) throw Error("tubes: the radius must be > 0 mm");
+    }
+    return ViewerAction{t};
+  }
   if (name == "anatomy") {
     expectArguments(w, 1, 1, "anatomy FILE.nii[.gz]");
     return ViewerAction{AnatomyAction{std::string(w[1])}};
@@ -428,10 +442,10 @@ std::vector<ViewerAction> ScriptRunner::nextFrame(bool loading, bool exporting, 
     }
     const ViewerAction& action = std::get<ViewerAction>(step.command);
     actions.push_back(action);
-    if (std::holds_alternative<AnatomyAction>(action)) {
-      // The image is read while frames go on: the steps after it (a
-      // screenshot, a slice setting) see it shown, as after `open` and
-      // `wait-loaded`.
+    if (std::holds_alternative<AnatomyAction>(action) || std::holds_alternative<TubesAction>(action)) {
+      // The image is read (the tubes built) while frames go on: the steps
+      // after it (a screenshot, a slice setting) see it shown, as after
+      // `open` and `wait-loaded`.
       waiting_loaded_ = true;
       break;
     }

@@ -96,6 +96,23 @@ struct AnatomyInfo {
   bool loaded() const { return !path.empty(); }
 };
 
+// Spline tubes (issue 15 item 5; viewer_tubes.h builds them, the tubes
+// panel viewer_ui_tubes.cpp edits this): which fibers are drawn as tubes
+// over the lines, their radius and resampling tolerance, and the last
+// build. The method, rings, vertices and MSAA are settings (group "tubes").
+struct TubesInfo {
+  bool selection = false;  // the picked selection as tubes
+  bool filtered = false;   // the dissection's kept fibers as tubes (with the selection's, when both)
+  float radius_mm = 0.5f;
+  float tolerance_mm = 0.025f;  // resampling (TubeBuildOptions::resample_tolerance)
+  // The last build (the frame loop fills these).
+  bool building = false;
+  uint64_t fibers = 0, nodes = 0, points = 0, segments = 0, bytes = 0;
+  double build_seconds = 0;
+  std::string message;  // why there are none, or what failed
+  bool wanted() const { return selection || filtered; }
+};
+
 struct ViewerState {
   RenderSettings settings;
   double fov_deg = 30;
@@ -143,6 +160,7 @@ struct ViewerState {
   std::string status;
 
   BundlingInfo bundling;
+  TubesInfo tubes;
 
   // UI flags.
   bool show_settings = true;
@@ -154,6 +172,7 @@ struct ViewerState {
   bool show_dissection = false;
   bool show_anatomy = true;
   bool show_bundling = true;
+  bool show_tubes = false;
   std::string screenshot_path = "fibscope.png";  // the screenshot button's file
   std::string open_path;                         // the models panel's path entry
   int screenshot_width = 0, screenshot_height = 0;  // 0: the window as shown

@@ -196,6 +196,7 @@ std::vector<ViewerAction> drawViewerUi(ViewerState& state) {
       ImGui::MenuItem("Dissection", nullptr, &state.show_dissection);
       ImGui::MenuItem("Anatomy", nullptr, &state.show_anatomy);
       ImGui::MenuItem("Bundle", nullptr, &state.show_bundling);
+      ImGui::MenuItem("Tubes", nullptr, &state.show_tubes);
       ImGui::EndMenu();
     }
     if (ImGui::MenuItem("Screenshot")) actions.push_back(ScreenshotAction{});
@@ -210,6 +211,7 @@ std::vector<ViewerAction> drawViewerUi(ViewerState& state) {
   if (state.show_dissection) drawDissectionPanel(state, actions);
   if (state.show_anatomy) drawAnatomyPanel(state, actions);
   if (state.show_bundling) drawBundlingPanel(state, actions);
+  if (state.show_tubes) drawTubesPanel(state, actions);
   statusLine(state);
   return actions;
 }

@@ -47,5 +47,9 @@ void drawAnatomyPanel(ViewerState& state, std::vector<ViewerAction>& actions);
 // and Cancel, the job's progress with rate and ETA, original / bundled,
 // Save bundled...).
 void drawBundlingPanel(ViewerState& state, std::vector<ViewerAction>& actions);
+// viewer_ui_tubes.cpp: the Tubes panel (selection / filtered fibers as
+// spline tubes, radius, tolerance, method, rings, vertices, MSAA, the
+// last build).
+void drawTubesPanel(ViewerState& state, std::vector<ViewerAction>& actions);
 
 }  // namespace fibscope

@@ -378,6 +378,7 @@ void drawDissectionPanel(ViewerState& state, std::vector<ViewerAction>& actions)
       ImGui::TextColored(kWarning, "updating...");
     else
       ImGui::TextDisabled("(%.0f ms)", stats.update_ms);
+    if (ImGui::Checkbox("show kept as tubes", &state.tubes.filtered) && state.tubes.filtered) state.show_tubes = true;
   } else {
     ImGui::TextDisabled("no criteria: all %llu fibers kept", static_cast<unsigned long long>(stats.fibers));
   }

@@ -30,6 +30,7 @@ void drawSelectionPanel(ViewerState& state, std::vector<ViewerAction>& actions) 
   ImGui::SameLine();
   if (ImGui::SmallButton("Clear")) actions.push_back(ClearSelectionAction{});
   ImGui::TextDisabled("click: select, ctrl-click: add or remove");
+  if (ImGui::Checkbox("show as tubes", &state.tubes.selection) && state.tubes.selection) state.show_tubes = true;
 
   // A scrolling table: at most ~8 rows tall, the clipper draws only the
   // visible rows of a long selection.

@@ -83,6 +83,7 @@ class TubeRasterStage final : public FrameStage {
       gpu::recordDispatch(frame.cmd, resolve_, push, (width + g - 1) / g, (height + g - 1) / g);
     }
   }
+  void collect(const gpu::VulkanContext&, FrameStats& stats) override { stats.tube_method_bytes = keys_.size; }
 
  private:
   const GpuTubes* tubes_;

@@ -103,6 +103,7 @@ class TubeRaycastStage final : public FrameStage {
     uint32_t overflowed = 0;
     gpu::downloadFromBuffer(context, overflow_readback_, &overflowed, sizeof(overflowed));
     stats.tube_tiles_overflowed = overflowed;
+    stats.tube_method_bytes = tile_counts_.size + tile_lists_.size;
   }
 
  private:

@@ -10,6 +10,7 @@
 #include "core/error.h"
 #include "render/gpu/frame_stages.h"
 #include "tubes/gpu/gpu_tubes.h"
+#include "tubes/gpu/tube_raster_stage.h"
 
 namespace fibscope {
 namespace {
@@ -54,6 +55,7 @@ class TubeStage final : public FrameStage {
       case TubeMethod::Compute:
         return tubeRaycastStage(tubes_);
       case TubeMethod::Raycast:
+        return tubeRasterRaycastStage(tubes_);
       case TubeMethod::Tessellation:
         break;
     }

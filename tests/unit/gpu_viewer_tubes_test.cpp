@@ -1,0 +1,99 @@
+// The viewer's spline tubes (viewer_tubes.h, the `tubes` script command,
+// the tubes panel) as a user meets them: the dissection's kept fibers drawn
+// as tubes over the lines, the method switched from the settings (compute
+// and fragment ray casting write the same texels, gpu_tube_raster_test.cpp,
+// so the frames are the same), "off" giving back the lines' frame exactly,
+// and the tubes following the criteria (none kept: no tubes). Offscreen,
+// validation layers on, 300 phantom fibers at 320 x 200.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <variant>
+
+#include "app/viewer/viewer_script.h"
+#include "core/error.h"
+#include "test_support.h"
+
+namespace fibscope {
+namespace {
+
+size_t differingPixels(const test::Png& a, const test::Png& b) {
+  EXPECT_EQ(a.rgba.size(), b.rgba.size());
+  size_t n = 0;
+  for (size_t i = 0; i + 3 < a.rgba.size() && i + 3 < b.rgba.size(); i += 4)
+    n += a.rgba[i] != b.rgba[i] || a.rgba[i + 1] != b.rgba[i + 1] || a.rgba[i + 2] != b.rgba[i + 2];
+  return n;
+}
+
+// Pixels brighter than the background (black).
+size_t drawnPixels(const test::Png& p) {
+  size_t n = 0;
+  for (size_t i = 0; i + 3 < p.rgba.size(); i += 4) n += p.rgba[i] + p.rgba[i + 1] + p.rgba[i + 2] > 30;
+  return n;
+}
+
+TEST(ViewerScriptTubes, parsesWhichFibersAndTheRadius) {
+  const auto steps = parseScript("tubes selection 2.5\ntubes both\ntubes filtered\ntubes off\n", "s.txt");
+  ASSERT_EQ(steps.size(), 4u);
+  const auto tubes = [&](size_t i) { return std::get<TubesAction>(std::get<ViewerAction>(steps[i].command)); };
+  EXPECT_TRUE(tubes(0).selection && !tubes(0).filtered);
+  EXPECT_EQ(tubes(0).radius_mm, 2.5f);
+  EXPECT_TRUE(tubes(1).selection && tubes(1).filtered);
+  EXPECT_EQ(tubes(1).radius_mm, 0.0f);  // keeps the radius
+  EXPECT_TRUE(!tubes(2).selection && tubes(2).filtered);
+  EXPECT_TRUE(!tubes(3).selection && !tubes(3).filtered);
+  for (const char* bad : {"tubes\n", "tubes all\n", "tubes selection 0\n", "tubes selection -1\n",
+                          "tubes selection x\n", "tubes off 1 2\n"})
+    EXPECT_THROW(parseScript(bad, "s.txt"), Error) << bad;
+}
+
+class GpuViewerTubes : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto r = test::runFibscope("gpu-info");
+    if (r.exit_code != 0) GTEST_SKIP() << "no usable Vulkan device: " << r.output;
+  }
+  test::TempDir dir_;
+};
+
+TEST_F(GpuViewerTubes, keptFibersShowAsTubesByEitherMethodAndOffGivesTheLinesBack) {
+  const auto png = [&](const char* name) { return dir_.file(name); };
+  const std::string script = dir_.file("tubes.txt");
+  test::writeBytes(script,
+                   "wait 2\n"
+                   "screenshot " + png("all.png") + " 320x200\n"
+                   "roi-add a include sphere:0,0,20,15\n"
+                   "wait 2\n"
+                   "screenshot " + png("kept.png") + " 320x200\n"
+                   "tubes filtered 1.5\n"  // the script goes on once they are built
+                   "screenshot " + png("tubes.png") + " 320x200\n"
+                   "set tube-method raycast\n"
+                   "wait 1\n"
+                   "screenshot " + png("raycast.png") + " 320x200\n"
+                   "tubes off\n"
+                   "wait 1\n"
+                   "screenshot " + png("off.png") + " 320x200\n"
+                   "tubes filtered\n"
+                   "roi-remove a\n"  // no criteria: no kept fibers to take
+                   "wait 3\n"
+                   "screenshot " + png("none.png") + " 320x200\n"
+                   "quit\n");
+  const auto r = test::runCommand("FIBSCOPE_CACHE_DIR='" + dir_.path() + "' " + std::string(FIBSCOPE_EXE) +
+                                  " view --validate --phantom-streamlines 300 --offscreen --size 320x200 "
+                                  "--no-orientation-labels --script " + script);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const test::Png all = test::readOurPng(png("all.png")), kept = test::readOurPng(png("kept.png")),
+                  tubes = test::readOurPng(png("tubes.png")), raycast = test::readOurPng(png("raycast.png")),
+                  off = test::readOurPng(png("off.png")), none = test::readOurPng(png("none.png"));
+  ASSERT_EQ(tubes.width, 320u);
+  // The filter keeps some fibers; as 3 mm tubes they cover more pixels
+  // than as 1 px lines.
+  EXPECT_LT(drawnPixels(kept), drawnPixels(all));
+  EXPECT_GT(drawnPixels(tubes), drawnPixels(kept) + 500) << drawnPixels(tubes) << " vs " << drawnPixels(kept);
+  EXPECT_EQ(differingPixels(tubes, raycast), 0u);
+  EXPECT_EQ(differingPixels(off, kept), 0u);
+  EXPECT_EQ(differingPixels(none, all), 0u);
+}
+
+}  // namespace
+}  // namespace fibscope
