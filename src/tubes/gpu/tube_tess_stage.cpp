@@ -38,6 +38,7 @@ class TubeTessStage final : public FrameStage {
     ensurePipeline(context, sampleCount(settings));
   }
   void resize(const gpu::VulkanContext& context, uint32_t, uint32_t) override { gpu::destroyBuffer(context, keys_); }
+  void collect(const gpu::VulkanContext&, FrameStats& stats) override { stats.tube_method_bytes = keys_.size; }
 
   void record(FrameContext& frame) override {
     // Again here, before any command: the method-switching stage
