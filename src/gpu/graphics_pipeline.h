@@ -33,6 +33,9 @@ struct GraphicsPipelineDesc {
   // The line width is dynamic state (vkCmdSetLineWidth before drawing;
   // widths other than 1 need the wideLines feature).
   bool dynamic_line_width = false;
+  // Rasterisation samples (multisampling; without attachments the device's
+  // framebufferNoAttachmentsSampleCounts says which are allowed).
+  VkSampleCountFlagBits samples = VK_SAMPLE_COUNT_1_BIT;
 };
 
 struct GraphicsPipeline {

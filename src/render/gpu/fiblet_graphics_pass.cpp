@@ -79,8 +79,7 @@ FibletGraphicsPass createFibletGraphicsPass(const gpu::VulkanContext& context, R
   desc.dynamic_line_width = true;
   FibletGraphicsPass pass;
   pass.kind = kind;
-  if (kind == RenderPipeline::Tessellation && context.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU)
-    pass.patches_per_draw = kCpuTessellationPatchesPerDraw;
+  if (kind == RenderPipeline::Tessellation) pass.patches_per_draw = gpu::tessellationPatchesPerDraw(context);
   try {
     pass.pipeline = gpu::createGraphicsPipeline(context, desc);
     pass.draw_args =
@@ -160,7 +159,6 @@ void recordFibletGraphics(VkCommandBuffer cmd, const gpu::VulkanContext& context
     push.list = culled ? culled->list.address + culled->regions[i].list_offset : 0;
     push.fiber_base = e.fiber_base;
     vkCmdPushConstants(cmd, pass.pipeline.layout, pass.pipeline.stages, 0, sizeof(push), &push);
-    const uint32_t chunk = pass.patches_per_draw == 0 ? e.fiblets : pass.patches_per_draw;
     if (culled) {
       const VkDeviceSize offset = VkDeviceSize(pass.command_first[i]) * sizeof(VkDrawIndirectCommand);
       const uint32_t commands = pass.command_count[i];
@@ -172,8 +170,7 @@ void recordFibletGraphics(VkCommandBuffer cmd, const gpu::VulkanContext& context
                             sizeof(VkDrawIndirectCommand));
       }
     } else {
-      for (uint32_t first = 0; first < e.fiblets; first += chunk)
-        vkCmdDraw(cmd, std::min(chunk, e.fiblets - first), 1, first, 0);
+      gpu::recordPatchDraws(cmd, 0, e.fiblets, pass.patches_per_draw);
     }
   }
   endLineAttachmentsIntoGBuffer(cmd, pass.attachments, frame);

@@ -35,6 +35,7 @@
 #include "gpu/buffer.h"
 #include "gpu/compute_pipeline.h"
 #include "gpu/graphics_pipeline.h"
+#include "gpu/tessellation_draws.h"
 #include "gpu/vulkan_context.h"
 #include "render/gpu/cull_passes.h"
 #include "render/gpu/frame_targets.h"
@@ -56,7 +57,7 @@ struct FibletGraphicsPass {
   std::vector<uint32_t> command_first, command_count;
 };
 
-inline constexpr uint32_t kCpuTessellationPatchesPerDraw = 64;
+inline constexpr uint32_t kCpuTessellationPatchesPerDraw = gpu::kCpuTessellationPatchesPerDraw;
 
 // The pipeline of `kind` (Geometry or Tessellation). Throws Error (one
 // line) when the device lacks a graphics queue, the stage's feature
