@@ -91,19 +91,22 @@ TEST_F(GpuCliTubes, filteredTubesAreTheFibersTheFilterKeeps) {
 TEST_F(GpuCliTubes, benchDrawsEachTubeMethodOnTheSameFrames) {
   const auto r = runFibscope(
       "bench --validate --phantom-streamlines 60 --size 80x60 --frames 2 --warmup 0 --tubes 0-9 --tube-radius 0.8 "
-      "--tube-compare none,compute,raycast --json");
+      "--tube-compare none,compute,raycast,tess --json");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const nlohmann::json j = nlohmann::json::parse(r.output.substr(r.output.find('{')));
   EXPECT_EQ(j["tubes"]["fibers"], 10);
   EXPECT_GT(j["tubes"]["segments"].get<uint64_t>(), 10u);
   EXPECT_EQ(j["tubes"]["buffer_bytes"].get<uint64_t>(),
             48 * j["tubes"]["nodes"].get<uint64_t>() + 16 * j["tubes"]["segments"].get<uint64_t>());
-  ASSERT_EQ(j["results"].size(), 3u);
+  ASSERT_EQ(j["results"].size(), 4u);
   EXPECT_FALSE(j["results"][0].contains("tube_method"));
   EXPECT_EQ(j["results"][1]["tube_method"], "compute");
   EXPECT_EQ(j["results"][2]["tube_method"], "raycast");
   EXPECT_TRUE(j["results"][1]["pass_mean_ms"].contains("tube raycast")) << j["results"][1].dump();
   EXPECT_TRUE(j["results"][2]["pass_mean_ms"].contains("tube boxes")) << j["results"][2].dump();
+  EXPECT_EQ(j["results"][3]["tube_method"], "tess");
+  EXPECT_TRUE(j["results"][3]["pass_mean_ms"].contains("tube tess")) << j["results"][3].dump();
+  EXPECT_GT(j["results"][3]["tube_method_bytes"].get<uint64_t>(), 0u);
   EXPECT_FALSE(j["results"][0]["pass_mean_ms"].contains("tube raycast"));
   for (const auto& [args, want] : std::vector<std::pair<std::string, std::string>>{
            {" --tube-compare compute", "--tube-compare"}, {" --tubes 0-3 --tube-compare compute,cubes", "cubes"}}) {

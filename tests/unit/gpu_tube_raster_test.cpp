@@ -213,8 +213,9 @@ TEST_F(GpuTubeRaster, fragmentAndComputeVariantsWriteTheSameTexelsOnAOnePointSph
 }
 
 // The tube stage (tubeStage: the method by RenderSettings::tube_method,
-// frame to frame in one renderer) draws what each method's own stage
-// draws, texel for texel, and switching back gives the first frame again.
+// frame to frame in one renderer) draws what each ray-casting method's own
+// stage draws, texel for texel, the tessellated tubes where the compute
+// caster draws, and switching back gives the first frame again.
 TEST_F(GpuTubeRaster, theTubeStageSwitchesMethodsFrameToFrameAsTheirOwnStagesDraw) {
   const test::TubeScene scene = test::tubeScenes().front();  // a copy: tubeScenes() returns by value
   const TubeModel model = buildTubes(scene.tractogram, scene.options);
@@ -235,6 +236,13 @@ TEST_F(GpuTubeRaster, theTubeStageSwitchesMethodsFrameToFrameAsTheirOwnStagesDra
     };
     expectSameTexels(compareVariants(frame(TubeMethod::Compute, "tube raycast"), compute), "compute");
     expectSameTexels(compareVariants(frame(TubeMethod::Raycast, "tube boxes"), raster), "raycast");
+    // Tessellated cylinders are not the ray casters' sphere-swept tubes
+    // texel for texel (faceting, gpu_tube_tess_test.cpp bounds it): the
+    // same fibers where both cover, nearly the same pixels.
+    const Identity tess = compareVariants(frame(TubeMethod::Tessellation, "tube tess"), compute);
+    EXPECT_GT(tess.covered, 100u) << tess.summary();
+    EXPECT_LE(tess.mask_mismatch, tess.covered / 20) << tess.summary();
+    EXPECT_LE(tess.fiber_mismatch, tess.covered / 100) << tess.summary();
     expectSameTexels(compareVariants(frame(TubeMethod::Compute, "tube raycast"), compute), "compute again");
   } catch (...) {
     destroyTubes(context(), tubes);

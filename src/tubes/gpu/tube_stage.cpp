@@ -11,6 +11,7 @@
 #include "render/gpu/frame_stages.h"
 #include "tubes/gpu/gpu_tubes.h"
 #include "tubes/gpu/tube_raster_stage.h"
+#include "tubes/gpu/tube_tess_stage.h"
 
 namespace fibscope {
 namespace {
@@ -30,7 +31,11 @@ class TubeStage final : public FrameStage {
   uint32_t maxPasses() const override { return kMaxMethodPasses; }
   bool runs(const FrameContext&) const override { return tubes_ && tubes_->segment_count > 0; }
   bool drawsSurfaces() const override { return true; }
-  void check(const FrameContext& frame) const override { factory(frame.settings.tube_method); }
+  // The method's own checks (settings it refuses, features the device
+  // lacks): the method is made here if it was not yet, as record would.
+  void check(const FrameContext& frame) const override {
+    method(frame.context, frame.settings.tube_method).check(frame);
+  }
   void prepare(const gpu::VulkanContext& context, const RenderSettings& settings) override {
     method(context, settings.tube_method).prepare(context, settings);
   }
@@ -57,18 +62,18 @@ class TubeStage final : public FrameStage {
       case TubeMethod::Raycast:
         return tubeRasterRaycastStage(tubes_);
       case TubeMethod::Tessellation:
-        break;
+        return tubeTessellationStage(tubes_);
     }
     throw Error("tube-method " + std::string(tubeMethodName(m)) + ": not available in this build");
   }
-  FrameStage& method(const gpu::VulkanContext& context, TubeMethod m) {
+  FrameStage& method(const gpu::VulkanContext& context, TubeMethod m) const {
     std::unique_ptr<FrameStage>& slot = methods_.at(size_t(m));
     if (!slot) slot = factory(m)(context);
     return *slot;
   }
 
   const GpuTubes* tubes_;
-  std::array<std::unique_ptr<FrameStage>, kMethods> methods_;
+  mutable std::array<std::unique_ptr<FrameStage>, kMethods> methods_;  // made by the first frame (or check) using each
   FrameStage* recorded_ = nullptr;  // the method recorded since the last collect
 };
 
