@@ -15,6 +15,7 @@
 #define SHADE_COMMON_NO_TILES  // vertex/fragment stage: no workgroup built-ins
 #include "glsl/shade_common.glsl"
 #include "glsl/tube_intersect.glsl"
+#include "glsl/surface_cuts.glsl"
 
 layout(push_constant, std430) uniform Push { TubeBoxPush pc; };
 
@@ -40,6 +41,7 @@ void main() {
   if (!(c.w > 0.0)) return;
   const float depth = c.z / c.w;
   if (!(depth >= 0.0 && depth <= 1.0)) return;
+  if (!surfaceCutsKeep(cam, o + s * d, p.y * pc.width + p.x, depth)) return;
   const uint64_t key = (uint64_t(floatBitsToUint(depth)) << 32) | uint64_t(in_item);
   atomicMin(KeysRef(pc.visibility).keys[p.y * pc.width + p.x], key);
 }

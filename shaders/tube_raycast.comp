@@ -18,6 +18,7 @@
 #include "glsl/tangent.glsl"
 #include "glsl/tube_intersect.glsl"
 #include "glsl/tube_texel.glsl"
+#include "glsl/surface_cuts.glsl"
 
 // kTubeTileSize x kTubeTileSize
 layout(local_size_x_id = WORKGROUP_SIZE_X_ID, local_size_y_id = WORKGROUP_SIZE_Y_ID) in;
@@ -81,7 +82,8 @@ void main() {
       // Strictly nearer than what other surfaces left; ties between tube
       // items: the smaller item (the CPU reference's order).
       if (depth >= 0.0 && depth <= 1.0 &&
-          (depth < best_depth || (best_item != 0xFFFFFFFFu && depth == best_depth && s_items[j] < best_item))) {
+          (depth < best_depth || (best_item != 0xFFFFFFFFu && depth == best_depth && s_items[j] < best_item)) &&
+          surfaceCutsKeep(cam, o + s * d, index, depth)) {
         best_depth = depth;
         best_item = s_items[j];
         best_t = t;

@@ -15,6 +15,7 @@
 #include "shared/gbuffer.h"
 #include "shared/tube_tess.h"
 #include "glsl/tangent.glsl"
+#include "glsl/cut_mesh.glsl"
 
 layout(push_constant, std430) uniform Push { TubeTessPush pc; };
 
@@ -33,6 +34,12 @@ void main() {
   const uint index = p.y * pc.width + p.x;
   const float depth = gl_FragCoord.z;
   if (!(depth >= 0.0 && depth <= 1.0)) return;
+  // Mesh cuts per pixel (the clip planes clipped the triangles already:
+  // tube_tess.tese), as surface_cuts.glsl.
+  const CameraBlock cam = CameraRef(pc.camera).camera;
+  if (cam.mesh_cuts.mesh_count != 0u &&
+      !cutMeshesKeep(cam.mesh_cuts, uint(cam.viewport.x) * uint(cam.viewport.y), index, depth))
+    return;
   const uint64_t key = (uint64_t(floatBitsToUint(depth)) << 32) | uint64_t(in_patch);
   KeysRef keys = KeysRef(pc.visibility);
   if (pc.samples <= 1u) {

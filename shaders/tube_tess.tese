@@ -27,6 +27,13 @@ layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer Se
 
 layout(location = 0) patch in uint patch_index;
 
+// The frame's clip planes clip the triangles exactly (surface_cuts.glsl's
+// rule for the planes; mesh cuts in tube_tess.frag).
+out gl_PerVertex {
+  vec4 gl_Position;
+  float gl_ClipDistance[kMaxFrameClipPlanes];
+};
+
 layout(location = 0) out vec3 out_normal;
 layout(location = 1) out vec3 out_tangent;  // 0: none (a one-point tube)
 layout(location = 2) out float out_position;
@@ -65,7 +72,11 @@ void main() {
     u = start ? 0.0 : 1.0;
     p = tubeTessCapPoint(g, start ? -1.0 : 1.0, around, y, normal);
   }
-  gl_Position = cameraTransformPoint(CameraRef(pc.camera).camera.view_projection, p);
+  const CameraBlock cam = CameraRef(pc.camera).camera;
+  gl_Position = cameraTransformPoint(cam.view_projection, p);
+  const uint planes = uint(cam.cuts.x);
+  for (uint c = 0u; c < kMaxFrameClipPlanes; ++c)
+    gl_ClipDistance[c] = c < planes ? dot(cam.clip_world[c].xyz, p) + cam.clip_world[c].w : 1.0;
   out_normal = normal;
   out_tangent = s.chord > 0.0 ? tubeTessTangent(g, u) : vec3(0.0);
   out_position = mix(a.point, b.point, u);
