@@ -35,6 +35,7 @@
 #include "glsl/tangent.glsl"
 #include "glsl/svo_capsule.glsl"
 #include "glsl/svo_curve.glsl"
+#include "glsl/surface_cuts.glsl"
 
 layout(local_size_x_id = WORKGROUP_SIZE_X_ID, local_size_y_id = WORKGROUP_SIZE_Y_ID) in;  // kSvoTraceTile^2
 
@@ -70,7 +71,18 @@ void main() {
   const vec3 ta = (origin - o) * inv_d, tb = (root_hi - o) * inv_d;
   const vec3 tn = min(ta, tb), tf = max(ta, tb);
   float t0 = max(max(tn.x, max(tn.y, tn.z)), 0.0);
-  const float t1 = min(tf.x, min(tf.y, tf.z));
+  float t1 = min(tf.x, min(tf.y, tf.z));
+  // The frame's clip planes (the user's and the slab's) cut the ray to the
+  // stretch they all keep, so the walk finds the first tube on the kept
+  // side: tubes are clipped, not dropped (a tube cut by a plane shows its
+  // surface up to it, open), and those behind a cut one still show.
+  const uint planes = min(uint(cam.cuts.x), kMaxFrameClipPlanes);
+  for (uint i = 0u; i < planes; ++i) {
+    const float nd = dot(cam.clip_world[i].xyz, d), f0 = dot(cam.clip_world[i].xyz, o) + cam.clip_world[i].w;
+    if (nd > 0.0) t0 = max(t0, -f0 / nd);
+    else if (nd < 0.0) t1 = min(t1, -f0 / nd);
+    else if (f0 < 0.0) return;
+  }
   if (!(t0 < t1)) return;
 
   // nudge: t past a cell's entry for its lookup (well above a float ulp of
@@ -179,6 +191,7 @@ void main() {
   if (!(clip.w > 0.0)) return;
   const float depth = clip.z / clip.w;
   if (depth < 0.0 || depth > 1.0 || !(depth < SurfaceRef(pc.surface).texels[index].depth)) return;
+  if (!surfaceCutsKeep(cam, hit, index, depth)) return;  // a mesh cut (or a hit within the slack before a plane)
   const TubeSegment s = SegmentsRef(pc.segments).segments[best_seg];
   const TubeNode na = NodesRef(pc.nodes).nodes[s.node], nb = NodesRef(pc.nodes).nodes[s.node + 1u];
   if (curved) {
