@@ -2,8 +2,9 @@
 // instanced tight boxes, tube_box.vert / tube_box.frag, then
 // tube_raster_resolve.comp) against the CPU reference of the intersection
 // (src/tubes/tube_intersect.h) and against the compute variant
-// (tubeRaycastStage) texel for texel; tubes and lines occluding each other
-// both ways; an empty model. Validation layers on; frames <= 160 x 120.
+// (tubeRaycastStage) texel for texel; the method-switching tube stage; an
+// empty model (tubes and lines occluding each other: gpu_tube_raycast_test.cpp,
+// for every method). Validation layers on; frames <= 160 x 120.
 // With FIBSCOPE_TUBE_BENCH=1, one more test times both variants on 300
 // phantom tubes at 800 x 600 (docs/BENCHMARKS.md).
 #include <gtest/gtest.h>
@@ -295,69 +296,6 @@ TEST_F(GpuTubeRaster, fragmentAndComputeVariantsAgreeWhereTileListsOverflow) {
   EXPECT_GT(a.both, 300u) << a.summary();
   EXPECT_GE(a.agreement(), 0.98) << a.summary();
   EXPECT_LE(a.fiber_mismatch, a.both / 50) << a.summary();  // tubes overlapping within float depth
-}
-
-// As the compute variant's test (tube_test_scenes.h's lines-and-tubes
-// scene, seen from +z): tube pixels where the reference tube is nearer
-// than the reference lines, line pixels where the lines are nearer.
-TEST_F(GpuTubeRaster, tubesAndLinesOccludeEachOtherBothWaysAsTheReferences) {
-  constexpr uint32_t w = 128, h = 96;
-  const test::LinesAndTubesScene setup = test::linesAndTubesScene(0.25f, w, h);
-  const TubeModel model = buildTubes(setup.tubes, setup.options);
-  const Camera& camera = setup.camera;
-  const ReferenceFrame line_ref = rasterizeReference(setup.lines, camera, 2.0f);
-  const TubeReferenceImage tube_ref = renderReferenceTubes(model, camera, TubeReferenceMethod::Cascade);
-  std::vector<uint8_t> want_tube(size_t(w) * h), want_line(size_t(w) * h);
-  size_t lines_over_tubes = 0, tubes_over_lines = 0;
-  for (size_t i = 0; i < want_tube.size(); ++i) {
-    const bool t = tube_ref.fiber[i] != shader::kNoFiberId, l = line_ref.fiber[i] != kNoFiber;
-    want_tube[i] = t && (!l || tube_ref.depth[i] < line_ref.depth[i]);
-    want_line[i] = l && !want_tube[i];
-    lines_over_tubes += t && want_line[i];
-    tubes_over_lines += l && want_tube[i];
-  }
-  ASSERT_GT(lines_over_tubes, 100u);
-  ASSERT_GT(tubes_over_lines, 100u);
-
-  const TractogramUpload upload = uploadTractogram(context(), setup.lines, "lines");
-  const GpuRawTractogram raw = GpuRawTractogram::upload(context(), setup.lines, "lines");
-  GpuTubes tubes = uploadTubes(context(), model);
-  try {
-    FrameRenderer renderer(context(), w, h, withTubeStage(standardFrameStages(), &tubes));
-    const GpuScene scene(&upload.dataset, &raw);
-    for (const RenderPipeline pipeline : {RenderPipeline::Compute, RenderPipeline::RawCompute}) {
-      SCOPED_TRACE(std::string(renderPipelineName(pipeline)));
-      RenderSettings settings;
-      settings.pipeline = pipeline;
-      settings.line_width_px = 2.0f;
-      settings.tube_method = TubeMethod::Raycast;  // the tube stage draws by the frame's method
-      const FrameStats stats = renderer.render(camera, settings, scene);
-      const auto texels = downloadGBuffer(context(), renderer.targets());
-      std::vector<uint8_t> got_tube, got_line;
-      for (const shader::GBufferTexel& t : texels) {
-        const bool tube = t.segment == (shader::kGBufferSurface | shader::kSurfaceSourceTube);
-        got_tube.push_back(tube);
-        got_line.push_back(!tube && t.fiber != shader::kNoFiberId);
-      }
-      const CoverageComparison ct = compareCoverage(got_tube, want_tube, w, h);
-      const CoverageComparison cl = compareCoverage(got_line, want_line, w, h);
-      EXPECT_GE(ct.agreement, 0.98) << "tubes: " << ct.summary();
-      EXPECT_LE(ct.maxDistance(), 1.0) << "tubes: " << ct.summary();
-      EXPECT_GE(cl.agreement, 0.98) << "lines: " << cl.summary();
-      EXPECT_LE(cl.maxDistance(), 1.0) << "lines: " << cl.summary();
-      bool timed_boxes = false, timed_compute = false;
-      for (const PassTiming& p : stats.passes) {
-        timed_boxes |= p.name == "tube boxes";
-        timed_compute |= p.name == "tube raycast";
-      }
-      EXPECT_TRUE(timed_boxes);
-      EXPECT_FALSE(timed_compute);
-    }
-  } catch (...) {
-    destroyTubes(context(), tubes);
-    throw;
-  }
-  destroyTubes(context(), tubes);
 }
 
 TEST_F(GpuTubeRaster, anEmptyModelDrawsNothing) {

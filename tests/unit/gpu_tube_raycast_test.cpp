@@ -144,10 +144,12 @@ TEST_F(GpuTubeRaycast, tilesWhoseListsOverflowStillDrawEveryTube) {
 
 // Lines along x in the plane z = 0 and tubes above them, below them and
 // through them (seen from +z): with the standard stages and the tube stage,
-// in the compute and raw-compute pipelines, the G-buffer's tube pixels
-// (kGBufferSurface | kSurfaceSourceTube) are where the reference tube is
-// nearer than the reference lines, and the lines' where they are nearer.
-TEST_F(GpuTubeRaycast, tubesAndLinesOccludeEachOtherBothWaysAsTheReferences) {
+// for every tube method (compute and fragment ray casting, tessellation;
+// the same test for all three) in the compute and raw-compute pipelines,
+// the G-buffer's tube pixels (kGBufferSurface | kSurfaceSourceTube) are
+// where the reference tube is nearer than the reference lines, and the
+// lines' where they are nearer.
+TEST_F(GpuTubeRaycast, tubesAndLinesOccludeEachOtherBothWaysAsTheReferencesForEveryMethod) {
   const test::LinesAndTubesScene setup = test::linesAndTubesScene(0.25f, 128, 96);
   const Tractogram& lines = setup.lines;
   const TubeModel model = buildTubes(setup.tubes, setup.options);
@@ -174,10 +176,14 @@ TEST_F(GpuTubeRaycast, tubesAndLinesOccludeEachOtherBothWaysAsTheReferences) {
   try {
     FrameRenderer renderer(context(), w, h, withTubeStage(standardFrameStages(), &tubes));
     const GpuScene scene(&upload.dataset, &raw);
+    const std::pair<TubeMethod, const char*> methods[] = {
+        {TubeMethod::Compute, "tube raycast"}, {TubeMethod::Raycast, "tube boxes"}, {TubeMethod::Tessellation, "tube tess"}};
+    for (const auto& [method, pass] : methods)
     for (const RenderPipeline pipeline : {RenderPipeline::Compute, RenderPipeline::RawCompute}) {
-      SCOPED_TRACE(std::string(renderPipelineName(pipeline)));
+      SCOPED_TRACE(std::string(tubeMethodName(method)) + " over " + std::string(renderPipelineName(pipeline)));
       RenderSettings settings;
       settings.pipeline = pipeline;
+      settings.tube_method = method;
       settings.line_width_px = 2.0f;
       const FrameStats stats = renderer.render(camera, settings, scene);
       const auto texels = downloadGBuffer(context(), renderer.targets());
@@ -193,12 +199,9 @@ TEST_F(GpuTubeRaycast, tubesAndLinesOccludeEachOtherBothWaysAsTheReferences) {
       EXPECT_LE(ct.maxDistance(), 1.0) << "tubes: " << ct.summary();
       EXPECT_GE(cl.agreement, 0.98) << "lines: " << cl.summary();
       EXPECT_LE(cl.maxDistance(), 1.0) << "lines: " << cl.summary();
-      bool timed_bin = false, timed_cast = false;
-      for (const PassTiming& p : stats.passes) {
-        timed_bin |= p.name == "tube bin";
-        timed_cast |= p.name == "tube raycast";
-      }
-      EXPECT_TRUE(timed_bin && timed_cast);
+      bool timed = false;
+      for (const PassTiming& p : stats.passes) timed |= p.name == pass;
+      EXPECT_TRUE(timed) << pass;
       // Picking a tube pixel names the tube's fiber and the source.
       for (size_t i = 0; i < got_tube.size(); ++i)
         if (got_tube[i] && want_tube[i] && tube_ref.fiber[i] == 1u) {

@@ -7,9 +7,9 @@
 // twist on sharp turns and a helix; supersampled coverage (tube_msaa)
 // matches too; the tube's colour along it as the
 // compute ray caster's; back-patch and frustum culling change
-// no texel;
-// tubes and lines occlude each other both ways; a one-point tube is a
-// sphere; an empty model draws nothing. Validation layers on; frames
+// no texel; a one-point tube is a
+// sphere; an empty model draws nothing (tubes and lines occluding each
+// other: gpu_tube_raycast_test.cpp, for every method). Validation layers on; frames
 // <= 128 x 96. FIBSCOPE_TUBE_TESS_PNG=DIR writes the images' normals as
 // PNGs to DIR for a look.
 #include <gtest/gtest.h>
@@ -547,80 +547,6 @@ TEST_F(GpuTubeTess, aOnePointTubeIsASphere) {
   EXPECT_GE(a.agreement(), 0.95) << a.summary();  // a disk of radius 7.9 px: 194 pixels
   EXPECT_LE(a.coverage.maxDistance(), 1.0) << a.summary();
   EXPECT_LE(a.max_depth_mm, 2.0 * (1.0 - std::cos(std::numbers::pi / 8))) << a.summary();
-}
-
-// withTubeStage's list with its method-switching stage swapped for the
-// tessellation stage.
-FrameStageList withTessTubeStage(const GpuTubes* tubes) {
-  FrameStageList stages = withTubeStage(standardFrameStages(), tubes);
-  using Factory = std::unique_ptr<FrameStage> (*)(const gpu::VulkanContext&);
-  for (size_t i = 0; i + 1 < stages.size(); ++i) {
-    const Factory* next = stages[i + 1].target<Factory>();
-    if (!stages[i].target<Factory>() && next && *next == &makeSurfaceMergeStage) {
-      stages[i] = tubeTessellationStage(tubes);
-      break;
-    }
-  }
-  EXPECT_EQ(stages.size(), standardFrameStages().size() + 1);
-  return stages;
-}
-
-// As the ray casters' test (tube_test_scenes.h's lines-and-tubes scene,
-// seen from +z): tube pixels where the reference tube is nearer than the
-// reference lines, line pixels where the lines are nearer.
-TEST_F(GpuTubeTess, tubesAndLinesOccludeEachOtherBothWaysAsTheReferences) {
-  constexpr uint32_t w = 128, h = 96;
-  const test::LinesAndTubesScene setup = test::linesAndTubesScene(0.25f, w, h);
-  const TubeModel model = buildTubes(setup.tubes, setup.options);
-  const Camera& camera = setup.camera;
-  const ReferenceFrame line_ref = rasterizeReference(setup.lines, camera, 2.0f);
-  const TubeReferenceImage tube_ref = renderReferenceTubes(model, camera, TubeReferenceMethod::Cascade);
-  std::vector<uint8_t> want_tube(size_t(w) * h), want_line(size_t(w) * h);
-  size_t lines_over_tubes = 0, tubes_over_lines = 0;
-  for (size_t i = 0; i < want_tube.size(); ++i) {
-    const bool t = tube_ref.fiber[i] != shader::kNoFiberId, l = line_ref.fiber[i] != kNoFiber;
-    want_tube[i] = t && (!l || tube_ref.depth[i] < line_ref.depth[i]);
-    want_line[i] = l && !want_tube[i];
-    lines_over_tubes += t && want_line[i];
-    tubes_over_lines += l && want_tube[i];
-  }
-  ASSERT_GT(lines_over_tubes, 100u);
-  ASSERT_GT(tubes_over_lines, 100u);
-
-  const TractogramUpload upload = uploadTractogram(context(), setup.lines, "lines");
-  const GpuRawTractogram raw = GpuRawTractogram::upload(context(), setup.lines, "lines");
-  GpuTubes tubes = uploadTubes(context(), model);
-  try {
-    FrameRenderer renderer(context(), w, h, withTessTubeStage(&tubes));
-    const GpuScene scene(&upload.dataset, &raw);
-    for (const RenderPipeline pipeline : {RenderPipeline::Compute, RenderPipeline::RawCompute}) {
-      SCOPED_TRACE(std::string(renderPipelineName(pipeline)));
-      RenderSettings settings;
-      settings.pipeline = pipeline;
-      settings.line_width_px = 2.0f;
-      const FrameStats stats = renderer.render(camera, settings, scene);
-      const auto texels = downloadGBuffer(context(), renderer.targets());
-      std::vector<uint8_t> got_tube, got_line;
-      for (const shader::GBufferTexel& t : texels) {
-        const bool tube = t.segment == (shader::kGBufferSurface | shader::kSurfaceSourceTube);
-        got_tube.push_back(tube);
-        got_line.push_back(!tube && t.fiber != shader::kNoFiberId);
-      }
-      const CoverageComparison ct = compareCoverage(got_tube, want_tube, w, h);
-      const CoverageComparison cl = compareCoverage(got_line, want_line, w, h);
-      EXPECT_GE(ct.agreement, 0.98) << "tubes: " << ct.summary();
-      EXPECT_LE(ct.maxDistance(), 1.0) << "tubes: " << ct.summary();
-      EXPECT_GE(cl.agreement, 0.98) << "lines: " << cl.summary();
-      EXPECT_LE(cl.maxDistance(), 1.0) << "lines: " << cl.summary();
-      bool timed_tess = false;
-      for (const PassTiming& p : stats.passes) timed_tess |= p.name == "tube tess";
-      EXPECT_TRUE(timed_tess);
-    }
-  } catch (...) {
-    destroyTubes(context(), tubes);
-    throw;
-  }
-  destroyTubes(context(), tubes);
 }
 
 TEST_F(GpuTubeTess, anEmptyModelDrawsNothing) {
