@@ -12,6 +12,9 @@
 
 #include "app/viewer/viewer_script.h"
 #include "core/error.h"
+#include "io/reader.h"
+#include "io/writer.h"
+#include "phantom/phantom.h"
 #include "test_support.h"
 
 namespace fibscope {
@@ -42,8 +45,14 @@ TEST(ViewerScriptTubes, parsesWhichFibersAndTheRadius) {
   EXPECT_EQ(tubes(1).radius_mm, 0.0f);  // keeps the radius
   EXPECT_TRUE(!tubes(2).selection && tubes(2).filtered);
   EXPECT_TRUE(!tubes(3).selection && !tubes(3).filtered);
+  const auto data = parseScript("tubes filtered from=w range=0.3,2\ntubes both from=\n", "s.txt");
+  EXPECT_EQ(std::get<TubesAction>(std::get<ViewerAction>(data[0].command)).radius_from, "w");
+  EXPECT_EQ(std::get<TubesAction>(std::get<ViewerAction>(data[0].command)).radius_min, 0.3f);
+  EXPECT_EQ(std::get<TubesAction>(std::get<ViewerAction>(data[0].command)).radius_max, 2.0f);
+  EXPECT_EQ(std::get<TubesAction>(std::get<ViewerAction>(data[1].command)).radius_from, "");
   for (const char* bad : {"tubes\n", "tubes all\n", "tubes selection 0\n", "tubes selection -1\n",
-                          "tubes selection x\n", "tubes off 1 2\n"})
+                          "tubes selection x\n", "tubes off 1 2\n", "tubes filtered range=2\n",
+                          "tubes filtered range=2,1\n", "tubes filtered range=0,1\n"})
     EXPECT_THROW(parseScript(bad, "s.txt"), Error) << bad;
 }
 
@@ -93,6 +102,45 @@ TEST_F(GpuViewerTubes, keptFibersShowAsTubesByEitherMethodAndOffGivesTheLinesBac
   EXPECT_EQ(differingPixels(tubes, raycast), 0u);
   EXPECT_EQ(differingPixels(off, kept), 0u);
   EXPECT_EQ(differingPixels(none, all), 0u);
+}
+
+// The radius from a per-fiber array (a TRX dps, kept in the .fbl as
+// "dps/w"): wider tubes than the constant smallest radius; an array the
+// model lacks is a message and no tubes (the lines' frame exactly).
+TEST_F(GpuViewerTubes, theRadiusComesFromAPerFiberArray) {
+  PhantomOptions p;
+  p.streamlines = 300;
+  Tractogram t = readAllStreamlines(*openPhantom(p));
+  DataArray w{"w", 1, "float32", {}};
+  for (size_t f = 0; f < t.streamlineCount(); ++f) w.values.push_back(float(f % 5));
+  t.per_streamline.push_back(w);
+  const std::string trx = dir_.file("w.trx");
+  writeTractogram(trx, t, TractogramHeader{});
+  const auto png = [&](const char* name) { return dir_.file(name); };
+  const std::string script = dir_.file("radius.txt");
+  test::writeBytes(script,
+                   "wait 2\n"
+                   "roi-add a include sphere:0,0,20,15\n"
+                   "wait 2\n"
+                   "screenshot " + png("kept.png") + " 320x200\n"
+                   "tubes filtered 0.2\n"
+                   "screenshot " + png("thin.png") + " 320x200\n"
+                   "tubes filtered from=w range=0.2,2\n"
+                   "screenshot " + png("data.png") + " 320x200\n"
+                   "tubes filtered from=missing\n"
+                   "wait 2\n"
+                   "screenshot " + png("missing.png") + " 320x200\n"
+                   "quit\n");
+  const auto r = test::runCommand("FIBSCOPE_CACHE_DIR='" + dir_.path() + "' " + std::string(FIBSCOPE_EXE) +
+                                  " view --validate --offscreen --size 320x200 --no-orientation-labels --script " +
+                                  script + " " + trx);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const test::Png kept = test::readOurPng(png("kept.png")), thin = test::readOurPng(png("thin.png")),
+                  data = test::readOurPng(png("data.png")), missing = test::readOurPng(png("missing.png"));
+  ASSERT_EQ(data.width, 320u);
+  // Four in five fibers get 0.65 to 2 mm instead of 0.2 mm.
+  EXPECT_GT(drawnPixels(data), drawnPixels(thin) + 500) << drawnPixels(data) << " vs " << drawnPixels(thin);
+  EXPECT_EQ(differingPixels(missing, kept), 0u);
 }
 
 }  // namespace

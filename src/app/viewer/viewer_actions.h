@@ -117,10 +117,13 @@ struct AnatomyAction {
 };
 // Which fibers the viewer draws as spline tubes (TubesInfo; viewer_tubes.h):
 // the selection's, the dissection's kept ones, both or none; radius_mm
-// > 0 also sets the radius.
+// > 0 also sets the radius, radius_from the per-fiber array the radius
+// comes from ("": the constant radius), radius_min > 0 its range.
 struct TubesAction {
   bool selection = false, filtered = false;
   float radius_mm = 0;
+  std::optional<std::string> radius_from;
+  float radius_min = 0, radius_max = 0;
 };
 // Moves the active slice (RenderSettings::active_slice) by this many
 // voxels, within the volume (Page Up / Page Down).

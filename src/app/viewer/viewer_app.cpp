@@ -858,6 +858,8 @@ void ViewerApp::apply(const ViewerAction& action) {
           state_.tubes.selection = a.selection;
           state_.tubes.filtered = a.filtered;
           if (a.radius_mm > 0) state_.tubes.radius_mm = a.radius_mm;
+          if (a.radius_from) state_.tubes.radius_from = *a.radius_from;
+          if (a.radius_min > 0) state_.tubes.radius_min = a.radius_min, state_.tubes.radius_max = a.radius_max;
           if (state_.tubes.wanted()) state_.show_tubes = true;  // as the panel's switches open it
         } else if constexpr (std::is_same_v<A, AnatomyAction>) {
           loadAnatomy(a.path);
@@ -1220,6 +1222,7 @@ void ViewerApp::syncTubes(const FrameScene& scene) {
   std::string key;
   if (info.wanted() && !scene.empty()) {
     key = std::to_string(info.selection) + std::to_string(info.filtered) + "|" + std::to_string(info.radius_mm) +
+          "|" + info.radius_from + ":" + std::to_string(info.radius_min) + "," + std::to_string(info.radius_max) +
           "|" + std::to_string(info.tolerance_mm) + "|";
     for (size_t k = 0; k < scene.models.size(); ++k)
       key += std::to_string(scenes_[size_t(scene.models[k])]->id) + ":" +

@@ -272,16 +272,33 @@ std::variant<ViewerAction, WaitFrames, WaitLoaded, WaitExported, WaitBundled> pa
     return ViewerAction{ResizeAction{uint32_t(width), uint32_t(height)}};
   }
   if (name == "tubes") {
-    expectArguments(w, 1, 2, "tubes selection|filtered|both|off [RADIUS_MM]");
+    expectArguments(w, 1, 4, "tubes selection|filtered|both|off [RADIUS_MM] [from=ARRAY|from=] [range=MIN,MAX]");
     TubesAction t;
     const std::string_view which = w[1];
     if (which != "selection" && which != "filtered" && which != "both" && which != "off")
       throw Error("tubes: expected selection, filtered, both or off, got '" + std::string(which) + "'");
     t.selection = which == "selection" || which == "both";
     t.filtered = which == "filtered" || which == "both";
-    if (w.size() == 3) {
-      t.radius_mm = float(number(w[2], "RADIUS_MM"));
-      if (!(t.radius_mm > 0.0f)) throw Error("tubes: the radius must be > 0 mm");
+    bool seen[3] = {false, false, false};  // radius, from=, range=: each once
+    for (size_t i = 2; i < w.size(); ++i) {
+      const std::string_view word = w[i];
+      const int kind = word.starts_with("from=") ? 1 : (word.starts_with("range=") ? 2 : 0);
+      if (seen[kind]) throw Error("tubes: '" + std::string(word) + "' repeats an argument");
+      seen[kind] = true;
+      if (kind == 1) {
+        t.radius_from = std::string(word.substr(5));
+      } else if (kind == 2) {
+        const std::string_view range = word.substr(6);
+        const size_t comma = range.find(',');
+        if (comma == std::string_view::npos) throw Error("tubes: expected range=MIN,MAX in mm");
+        t.radius_min = float(number(range.substr(0, comma), "MIN"));
+        t.radius_max = float(number(range.substr(comma + 1), "MAX"));
+        if (!(t.radius_min > 0.0f) || !(t.radius_max >= t.radius_min))
+          throw Error("tubes: the radius range must be > 0 mm and ordered");
+      } else {
+        t.radius_mm = float(number(word, "RADIUS_MM"));
+        if (!(t.radius_mm > 0.0f)) throw Error("tubes: the radius must be > 0 mm");
+      }
     }
     return ViewerAction{t};
   }

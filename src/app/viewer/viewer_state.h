@@ -104,6 +104,11 @@ struct TubesInfo {
   bool selection = false;  // the picked selection as tubes
   bool filtered = false;   // the dissection's kept fibers as tubes (with the selection's, when both)
   float radius_mm = 0.5f;
+  // The radius from a per-fiber array of the models (a .fbl "dps/NAME"
+  // section: trk properties, TRX dps) instead, its values' range mapped
+  // linearly onto [radius_min, radius_max] mm; empty: radius_mm.
+  std::string radius_from;
+  float radius_min = 0.2f, radius_max = 1.0f;
   float tolerance_mm = 0.025f;  // resampling (TubeBuildOptions::resample_tolerance)
   // The last build (the frame loop fills these).
   bool building = false;

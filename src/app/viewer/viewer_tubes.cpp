@@ -1,12 +1,48 @@
 #include "app/viewer/viewer_tubes.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <utility>
 
 #include "core/error.h"
 #include "render/fiber_selection.h"
 
 namespace fibscope {
+namespace {
+
+// Appends the values of `fibers` in `file`'s per-fiber array `name` (its
+// "dps/NAME" section, one float32 per fiber) to `out`'s per-streamline
+// array "radius". Throws Error naming the file when it has no such array.
+void appendFiberValues(const FblFile& file, const std::string& name, const std::vector<uint32_t>& fibers,
+                       Tractogram& out) {
+  const FblSection* s = file.find(std::string(kFblSectionDpsPrefix) + name);
+  if (!s || s->dtype != FblDType::kFloat32 || s->components != 1 || s->element_count != file.header().fiber_count)
+    throw Error("tubes: " + file.path() + " has no per-fiber array '" + name + "' of one float per fiber");
+  const auto values = file.array<float>(*s);
+  if (out.per_streamline.empty()) out.per_streamline.push_back(DataArray{"radius", 1, "float32", {}});
+  for (const uint32_t f : fibers) out.per_streamline[0].values.push_back(values[f]);
+}
+
+// The radius of the per-fiber values appendFiberValues collected: their
+// finite range mapped onto the panel's radii.
+TubeRadius dataRadius(const Tractogram& fibers, const TubesInfo& info) {
+  TubeRadius r;
+  r.source = TubeRadius::Source::PerFiber;
+  r.array = "radius";
+  r.radius_min = info.radius_min;
+  r.radius_max = info.radius_max;
+  if (!(r.radius_min > 0.0f) || !(r.radius_max >= r.radius_min))
+    throw Error("tubes: the radius range must be > 0 mm and ordered");
+  r.data_min = INFINITY;
+  r.data_max = -INFINITY;
+  for (const float v : fibers.per_streamline.at(0).values)
+    if (std::isfinite(v)) r.data_min = std::min(r.data_min, v), r.data_max = std::max(r.data_max, v);
+  if (r.data_min > r.data_max) r.data_min = r.data_max = 0.0f;  // no finite value: every tube radius_min
+  return r;
+}
+
+}  // namespace
 
 ViewerTubes::~ViewerTubes() {
   if (build_.valid()) build_.wait();
@@ -71,8 +107,10 @@ bool ViewerTubes::update(const std::string& key, const std::function<std::vector
           job.fibers.addStreamline(t.point(t.offsets[i]), t.pointsIn(i));
           job.scene_ids.push_back(source.fiber_base + source.fibers[i]);
         }
+        if (!info.radius_from.empty()) appendFiberValues(*source.fbl, info.radius_from, source.fibers, job.fibers);
       }
       if (!(info.radius_mm > 0.0f)) throw Error("tubes: the radius must be > 0 mm");
+      if (!info.radius_from.empty()) job.options.radius = dataRadius(job.fibers, info);
     } catch (const Error& e) {
       job.fibers = {};
       job.scene_ids.clear();

@@ -4,7 +4,9 @@
 // rings, vertices, MSAA) and the last build's numbers. The selection and
 // dissection panels carry the same two switches.
 #include <imgui.h>
+#include <imgui_stdlib.h>
 
+#include <algorithm>
 #include <string>
 
 #include "app/viewer/viewer_ui.h"
@@ -29,6 +31,17 @@ void drawTubesPanel(ViewerState& state, std::vector<ViewerAction>&) {
   ImGui::SliderFloat("radius (mm)", &radius, 0.05f, 5.0f, "%.2f", ImGuiSliderFlags_Logarithmic);
   if (ImGui::IsItemDeactivatedAfterEdit() || (!ImGui::IsItemActive() && radius != t.radius_mm))
     t.radius_mm = std::max(radius, 0.01f);
+  // The radius from a per-fiber array (committed on Enter or leaving the
+  // field, as the sliders).
+  std::string from = t.radius_from;
+  ImGui::InputTextWithHint("radius from", "a per-fiber array (trk property, TRX dps)", &from);
+  if (ImGui::IsItemDeactivatedAfterEdit()) t.radius_from = from;
+  if (!t.radius_from.empty()) {
+    float range[2] = {t.radius_min, t.radius_max};
+    ImGui::DragFloat2("radius range (mm)", range, 0.01f, 0.01f, 10.0f, "%.2f");
+    if (ImGui::IsItemDeactivatedAfterEdit() && range[0] > 0.0f && range[1] >= range[0])
+      t.radius_min = range[0], t.radius_max = range[1];
+  }
   ImGui::SliderFloat("tolerance (mm)", &tolerance, 0.0f, 0.5f, "%.3f");
   if (ImGui::IsItemHovered())
     ImGui::SetTooltip("Resampling: the tube's centre line stays within this distance of the fiber (0: every point)");
