@@ -2,7 +2,8 @@
 // and svo-curved as --compare entries beside a fiblet pipeline, each
 // tracing its own octree of the --tubes fibers on the same frames, the
 // build's sizes in the JSON; --voxel refused without an svo pipeline.
-// Validation layers on; a coarse voxel keeps the build small.
+// Each octree is render's for the same options. Validation layers on; a
+// coarse voxel keeps the build small.
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
@@ -35,9 +36,24 @@ TEST_F(GpuCliBenchSvo, svoPipelinesTraceTheirOctreesOnTheSameFrames) {
     EXPECT_TRUE(j["results"][i]["pass_mean_ms"].contains("svo trace")) << j["results"][i].dump();
     EXPECT_FALSE(j["results"][i]["pass_mean_ms"].contains("tube raycast")) << j["results"][i].dump();
   }
+  // Each octree is the one render builds for the same fibers and voxel
+  // (its summary line names the leaves and the node and decoration MB).
+  test::TempDir dir;
   for (const char* kind : {"svo-straight", "svo-curved"}) {
-    EXPECT_GT(j["svo"][kind]["leaves"].get<uint64_t>(), 100u) << kind;
-    EXPECT_EQ(j["svo"][kind]["node_bytes"].get<uint64_t>() % 8, 0u) << kind;  // 8-byte nodes
+    const auto rendered = test::runFibscope(std::string("render --phantom-streamlines 30 --size 64x48 --pipeline ") +
+                                            kind + " --tubes 0-3 --tube-radius 1 --voxel 1 -o " + dir.file("r.png"));
+    ASSERT_EQ(rendered.exit_code, 0) << rendered.output;
+    const size_t at = rendered.output.find(" leaves (");
+    ASSERT_NE(at, std::string::npos) << rendered.output;
+    const size_t start = rendered.output.rfind(' ', at - 1) + 1;
+    const uint64_t leaves = std::stoull(rendered.output.substr(start, at - start));
+    EXPECT_GT(leaves, 100u) << kind;
+    EXPECT_EQ(j["svo"][kind]["leaves"].get<uint64_t>(), leaves) << kind << ": " << j["svo"][kind]["summary"];
+    // The sizes part of the summary (the times differ run to run).
+    const std::string summary = j["svo"][kind]["summary"].get<std::string>();
+    const std::string sizes = summary.substr(0, summary.find("; voxelise"));
+    EXPECT_NE(rendered.output.find(sizes), std::string::npos)
+        << kind << ": bench's octree is not render's: " << sizes << " / " << rendered.output;
   }
   const auto bad = test::runFibscope("bench --phantom-streamlines 20 --size 32x24 --frames 1 --voxel 1");
   EXPECT_EQ(bad.exit_code, 2) << bad.output;
