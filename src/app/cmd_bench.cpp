@@ -114,18 +114,22 @@ void countMissed(const std::vector<uint64_t>& reference, const std::vector<uint6
   v.changed_pixels.push_back(changed);
 }
 
-constexpr std::string_view kSvoPipelines[] = {"svo-straight", "svo-curved"};
 
-int svoKind(std::string_view pipeline) {
-  for (int k = 0; k < 2; ++k)
-    if (pipeline == kSvoPipelines[k]) return k;
-  return -1;
+// "a,b,,c" -> {"a", "b", "", "c"} (an empty item is the parser's to refuse).
+std::vector<std::string> commaSeparated(const std::string& text) {
+  std::vector<std::string> items;
+  for (size_t start = 0;;) {
+    const size_t comma = text.find(',', start);
+    items.push_back(text.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+    if (comma == std::string::npos) return items;
+    start = comma + 1;
+  }
 }
 
 std::vector<Variant> variantsFrom(BenchOptions o) {
   // --pipeline svo-*: the compute pipeline's lines under the octree's tubes.
   std::string base_spec;
-  if (const auto p = o.render.values.find("pipeline"); p != o.render.values.end() && svoKind(p->second) >= 0) {
+  if (const auto p = o.render.values.find("pipeline"); p != o.render.values.end() && svoPipelineKind(p->second) >= 0) {
     base_spec = p->second;
     p->second = "compute";
   }
@@ -136,25 +140,10 @@ std::vector<Variant> variantsFrom(BenchOptions o) {
                                        : std::string(renderPipelineName(base.pipeline)) + "/" +
                                              std::string(cullingModeName(base.culling)));
   } else {
-    size_t start = 0;
-    while (start <= o.compare.size()) {
-      const size_t comma = o.compare.find(',', start);
-      specs.push_back(o.compare.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
-      if (comma == std::string::npos) break;
-      start = comma + 1;
-    }
+    specs = commaSeparated(o.compare);
   }
-  std::vector<std::string> tube_methods;
-  for (size_t start = 0; !o.tube_compare.empty() && start <= o.tube_compare.size();) {
-    const size_t comma = o.tube_compare.find(',', start);
-    tube_methods.push_back(o.tube_compare.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
-  bool svo = false;
-  for (const std::string& spec : specs) svo |= svoKind(spec.substr(0, spec.find('/'))) >= 0;
-  if (svo && o.tubes.requested() && !tube_methods.empty())
-    throw Error("--tube-compare: not with an svo pipeline (its tubes come from the octree)");
+  const std::vector<std::string> tube_methods = o.tube_compare.empty() ? std::vector<std::string>()
+                                                                       : commaSeparated(o.tube_compare);
   if (!tube_methods.empty() && !o.tubes.requested())
     throw Error("--tube-compare: give the tubes to draw (--tubes FIBERS|all|filtered)");
   std::vector<Variant> variants;
@@ -162,7 +151,7 @@ std::vector<Variant> variantsFrom(BenchOptions o) {
     Variant v;
     v.settings = base;
     const size_t slash = spec.find('/');
-    if (const int kind = svoKind(spec.substr(0, slash)); kind >= 0) {
+    if (const int kind = svoPipelineKind(spec.substr(0, slash)); kind >= 0) {
       if (!tube_methods.empty()) throw Error("--tube-compare: not with " + spec + " (its tubes come from the octree)");
       v.svo = kind;
       v.settings.pipeline = RenderPipeline::Compute;
@@ -241,12 +230,7 @@ void runBench(const BenchOptions& o) {
   for (const Variant& v : variants)
     if (v.svo >= 0) svo_used[v.svo] = true;
   TubeCliOptions tube_options = o.tubes;
-  if (svo_used[0] || svo_used[1]) {
-    // As render's: every fiber by default, and the fibers' own points
-    // (straight and curved tubes share their nodes).
-    if (tube_options.fibers.empty()) tube_options.fibers = "all";
-    if (tube_options.resample_tolerance_mm < 0.0f) tube_options.resample_tolerance_mm = 0.0f;
-  }
+  if (svo_used[0] || svo_used[1]) useSvoTubeDefaults(tube_options);
   if (o.voxel_mm != 0.0f && !(svo_used[0] || svo_used[1]))
     throw Error("--voxel: only with an svo-straight or svo-curved pipeline");
   if (!(o.voxel_mm >= 0.0f) || !std::isfinite(o.voxel_mm))
@@ -289,13 +273,13 @@ void runBench(const BenchOptions& o) {
                                        &svo_stats);
       svos[k] = uploadSvo(*context, tree);
       const std::string line = svoBuildSummary(model, tree, svo_stats);
-      if (!o.json) std::printf("%s: %s\n", std::string(kSvoPipelines[k]).c_str(), line.c_str());
-      out["svo"][std::string(kSvoPipelines[k])]["summary"] = line;
-      out["svo"][std::string(kSvoPipelines[k])]["node_bytes"] = tree.nodeBytes();
-      out["svo"][std::string(kSvoPipelines[k])]["decoration_bytes"] = tree.decorationBytes();
-      out["svo"][std::string(kSvoPipelines[k])]["leaves"] = tree.leaves;
-      out["svo"][std::string(kSvoPipelines[k])]["leaves_over_4"] = tree.leaves_over_4;
-      out["svo"][std::string(kSvoPipelines[k])]["build_s"] = svo_stats.voxelize_s + svo_stats.sort_s + svo_stats.tree_s;
+      if (!o.json) std::printf("%s: %s\n", std::string(kSvoPipelineNames[k]).c_str(), line.c_str());
+      out["svo"][std::string(kSvoPipelineNames[k])]["summary"] = line;
+      out["svo"][std::string(kSvoPipelineNames[k])]["node_bytes"] = tree.nodeBytes();
+      out["svo"][std::string(kSvoPipelineNames[k])]["decoration_bytes"] = tree.decorationBytes();
+      out["svo"][std::string(kSvoPipelineNames[k])]["leaves"] = tree.leaves;
+      out["svo"][std::string(kSvoPipelineNames[k])]["leaves_over_4"] = tree.leaves_over_4;
+      out["svo"][std::string(kSvoPipelineNames[k])]["build_s"] = svo_stats.voxelize_s + svo_stats.sort_s + svo_stats.tree_s;
     }
     out["tubes"]["fibers"] = tube_stats.tubes;
     out["tubes"]["nodes"] = tube_stats.nodes;
@@ -464,7 +448,7 @@ void runBench(const BenchOptions& o) {
     }
     j["segments_drawn_per_ms"] = segments_per_ms;
     if (!v.tube_ms.empty()) {
-      j["tube_method"] = v.svo >= 0 ? kSvoPipelines[v.svo] : tubeMethodName(v.settings.tube_method);
+      j["tube_method"] = v.svo >= 0 ? kSvoPipelineNames[v.svo] : tubeMethodName(v.settings.tube_method);
       j["tube_mean_ms"] = mean(v.tube_ms);
       j["tube_median_ms"] = percentile(v.tube_ms, 50);
       j["tube_method_bytes"] = v.tube_method_bytes;
@@ -496,7 +480,7 @@ void runBench(const BenchOptions& o) {
                                            variants.front().label.c_str());
       if (!v.tube_ms.empty())
         std::printf("\n    tubes by %s: mean %.3f ms, median %.3f ms (their passes' GPU time), its buffers %.2f MiB",
-                    std::string(v.svo >= 0 ? kSvoPipelines[v.svo] : tubeMethodName(v.settings.tube_method)).c_str(),
+                    std::string(v.svo >= 0 ? kSvoPipelineNames[v.svo] : tubeMethodName(v.settings.tube_method)).c_str(),
                     mean(v.tube_ms),
                     percentile(v.tube_ms, 50), double(v.tube_method_bytes) / double(1 << 20));
       std::printf("\n    passes:");

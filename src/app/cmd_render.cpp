@@ -47,8 +47,6 @@ struct RenderCommandOptions {
 // fibers left out of --tubes stay lines). `--pipeline svo-curved`: the same
 // with each segment the tube around its cubic Hermite centre line,
 // sphere-traced in the octree's leaves.
-constexpr const char* kSvoStraight = "svo-straight";
-constexpr const char* kSvoCurved = "svo-curved";
 
 using Clock = std::chrono::steady_clock;
 double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
@@ -84,15 +82,11 @@ void runRender(RenderCommandOptions o) {
     throw Error("-o: the output must be a .png file, got '" + o.output + "'");
   if (!o.view.empty() && !o.camera.empty()) throw Error("--view and --camera: give one of them");
   const auto pipeline = o.render.values.find("pipeline");
-  const bool svo_curved = pipeline != o.render.values.end() && pipeline->second == kSvoCurved;
-  const bool svo = svo_curved || (pipeline != o.render.values.end() && pipeline->second == kSvoStraight);
+  const int svo_kind = pipeline != o.render.values.end() ? svoPipelineKind(pipeline->second) : -1;
+  const bool svo = svo_kind >= 0, svo_curved = svo_kind == 1;
   if (svo) {
     o.render.values["pipeline"] = "compute";
-    if (o.tubes.fibers.empty()) o.tubes.fibers = "all";
-    // Tubes between the fiber's own points (resampling fits a Hermite
-    // curve, not a polyline; the curved tubes keep every point too, so
-    // straight and curved tubes share their nodes).
-    if (o.tubes.resample_tolerance_mm < 0.0f) o.tubes.resample_tolerance_mm = 0.0f;
+    useSvoTubeDefaults(o.tubes);
   }
   if (o.voxel_given && !svo) throw Error("--voxel: only with --pipeline svo-straight or svo-curved");
   if (o.voxel_given && !(o.voxel_mm > 0.0f && std::isfinite(o.voxel_mm)))

@@ -53,13 +53,7 @@ bool SceneFilter::distanceRange(float& lo, float& hi) const {
 }
 
 std::vector<uint32_t> SceneFilter::keptFibers() const {
-  std::vector<uint32_t> out;
-  if (!fiblets_) return out;
-  const std::vector<uint32_t> words = fiblets_->keptWords();
-  const uint64_t fibers = fiblets_->fiberCount();
-  for (uint64_t f = 0; f < fibers && f / 32 < words.size(); ++f)
-    if (words[f / 32] & (1u << (f % 32))) out.push_back(uint32_t(f));
-  return out;
+  return fiblets_ ? fiblets_->keptFibers() : std::vector<uint32_t>();
 }
 
 }  // namespace fibscope

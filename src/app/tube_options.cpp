@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "io/reader.h"
 #include "phantom/phantom.h"
+#include "select/number_list.h"
 
 namespace fibscope {
 namespace {
@@ -80,14 +81,11 @@ void copyRadiusData(const Tractogram& chunk, size_t i, const std::string& name, 
 
 // "A,B" as two finite numbers with A <= B; Error naming the option.
 void parsePair(const std::string& text, const char* option, float& a, float& b) {
-  const size_t comma = text.find(',');
-  const auto number = [&](std::string_view s, float& v) {
-    const auto r = std::from_chars(s.data(), s.data() + s.size(), v);
-    return !s.empty() && r.ec == std::errc() && r.ptr == s.data() + s.size() && std::isfinite(v);
-  };
-  if (comma == std::string::npos || !number(std::string_view(text).substr(0, comma), a) ||
-      !number(std::string_view(text).substr(comma + 1), b) || b < a)
+  std::vector<double> v;
+  if (!parseNumberList(text, v) || v.size() != 2 || v[1] < v[0])
     throw Error(std::string(option) + ": expected LO,HI with LO <= HI, got '" + text + "'");
+  a = float(v[0]);
+  b = float(v[1]);
 }
 
 // The radius of `selected`'s array `name` (copied there by copyRadiusData)
@@ -107,11 +105,7 @@ TubeRadius dataRadius(const Tractogram& selected, const std::string& name, const
     parsePair(o.radius_data, "--tube-radius-data", r.data_min, r.data_max);
     return r;
   }
-  r.data_min = INFINITY;
-  r.data_max = -INFINITY;
-  for (float v : a->values)
-    if (std::isfinite(v)) r.data_min = std::min(r.data_min, v), r.data_max = std::max(r.data_max, v);
-  if (r.data_min > r.data_max) r.data_min = r.data_max = 0.0f;  // no finite value: every radius radius_min
+  fitRadiusDataRange(r, a->values);
   return r;
 }
 
@@ -137,6 +131,17 @@ void addTubeCliOptions(CLI::App* cmd, TubeCliOptions& o) {
       "--tube-tolerance", o.resample_tolerance_mm,
       "Resample the tubes' centre lines within this distance of the fibers in mm (default: radius / 20; 0 keeps "
       "every point)");
+}
+
+int svoPipelineKind(std::string_view pipeline) {
+  for (int k = 0; k < 2; ++k)
+    if (pipeline == kSvoPipelineNames[k]) return k;
+  return -1;
+}
+
+void useSvoTubeDefaults(TubeCliOptions& o) {
+  if (o.fibers.empty()) o.fibers = "all";
+  if (o.resample_tolerance_mm < 0.0f) o.resample_tolerance_mm = 0.0f;
 }
 
 std::vector<uint32_t> parseFiberSelection(const std::string& text, uint64_t count) {

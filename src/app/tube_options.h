@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/tractogram.h"
@@ -35,6 +36,17 @@ struct TubeCliOptions {
 };
 
 void addTubeCliOptions(CLI::App* cmd, TubeCliOptions& options);
+
+// SVO streamtubes (render's and bench's `--pipeline svo-straight|svo-curved`,
+// bench's --compare entries): the octree of the --tubes fibers.
+inline constexpr std::string_view kSvoPipelineNames[] = {"svo-straight", "svo-curved"};
+// 0 svo-straight, 1 svo-curved, -1 any other pipeline name.
+int svoPipelineKind(std::string_view pipeline);
+// The tube options an octree is built with: every fiber unless --tubes
+// names them, and the fibers' own points unless --tube-tolerance is given
+// (resampling fits a Hermite curve, not a polyline; the curved tubes keep
+// every point too, so straight and curved tubes share their nodes).
+void useSvoTubeDefaults(TubeCliOptions& options);
 
 // "all" -> every index below `count`; "A-B,C,..." -> those indices, in the
 // order given, repeats dropped. Throws Error (one line, naming --tubes) for

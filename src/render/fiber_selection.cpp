@@ -150,12 +150,6 @@ void decodeFibers(const FblFile& file, std::span<const uint32_t> fibers, size_t 
   if (chunk.streamlineCount() > 0) sink(chunk);
 }
 
-Tractogram decodeFibers(const FblFile& file, std::span<const uint32_t> fibers) {
-  Tractogram all;
-  decodeFibers(file, fibers, SIZE_MAX, [&all](const Tractogram& chunk) { all = chunk; });
-  return all;
-}
-
 void exportFibers(const FblFile& file, std::span<const uint32_t> fibers, const std::string& tck_path,
                   bool overwrite) {
   if (fibers.empty()) fail(tck_path, "no fibers to export (the selection is empty)");

@@ -51,8 +51,6 @@ class FiberSelection {
 // was checked. Throws Error as exportFibers. Safe on untrusted files.
 void decodeFibers(const FblFile& file, std::span<const uint32_t> fibers, size_t chunk_points,
                   const std::function<void(const Tractogram&)>& sink);
-// All of them in one tractogram (selections, tubes).
-Tractogram decodeFibers(const FblFile& file, std::span<const uint32_t> fibers);
 
 // Writes the fibers `fibers` (in that order, duplicates written as often as
 // listed) of the .fbl `file` to the .tck `tck_path`: their fiblets decoded

@@ -208,6 +208,14 @@ glm::vec3 unpackUnitVector(uint32_t packed) {
   return glm::normalize(glm::vec3(x, y, z));
 }
 
+void fitRadiusDataRange(TubeRadius& r, std::span<const float> values) {
+  r.data_min = INFINITY;
+  r.data_max = -INFINITY;
+  for (const float v : values)
+    if (std::isfinite(v)) r.data_min = std::min(r.data_min, v), r.data_max = std::max(r.data_max, v);
+  if (r.data_min > r.data_max) r.data_min = r.data_max = 0.0f;
+}
+
 TubeModel buildTubes(const Tractogram& tractogram, const TubeBuildOptions& options, TubeBuildStats* stats_out) {
   checkOptions(options);
   const size_t fibers = tractogram.streamlineCount();

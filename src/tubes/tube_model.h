@@ -16,6 +16,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,11 @@ struct TubeRadius {
 };
 
 // A tube's own colour (TubeNode::color; alpha 0 leaves the colour mode's).
+// Sets r.data_min / r.data_max to the smallest and largest finite value of
+// `values` (a radius source's data over the fibers drawn); both 0 when
+// none is finite (every tube then takes radius_min).
+void fitRadiusDataRange(TubeRadius& r, std::span<const float> values);
+
 struct TubeColor {
   enum class Source { None, Constant, PerPoint };
   Source source = Source::None;

@@ -1227,8 +1227,7 @@ void ViewerApp::syncTubes(const FrameScene& scene) {
     for (size_t k = 0; k < scene.models.size(); ++k)
       key += std::to_string(scenes_[size_t(scene.models[k])]->id) + ":" +
              std::to_string(scene.layout.entries[k].fiber_base) + ",";
-    if (info.selection)
-      for (const SelectedEntry& e : selection_->entries()) key += std::to_string(e.model) + "." + std::to_string(e.fiber) + ",";
+    if (info.selection) key += "|selection " + std::to_string(selection_->revision());
     if (info.filtered) key += "|" + dissection_->keptKey();
   }
   const auto sources = [&]() {

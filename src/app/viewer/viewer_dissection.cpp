@@ -306,11 +306,7 @@ bool ViewerDissection::apply(const DissectionState& state, GpuScene& scene, bool
 
 std::optional<std::vector<uint32_t>> ViewerDissection::keptSceneFibers(const DissectionState& state) const {
   if (!state.stats.active || failed_ || scene_key_.empty() || raw_scene_ || !fiblets_) return std::nullopt;
-  std::vector<uint32_t> out;
-  const std::vector<uint32_t> words = fiblets_->keptWords();
-  for (uint64_t f = 0; f < fiblets_->fiberCount() && f / 32 < words.size(); ++f)
-    if (words[f / 32] & (1u << (f % 32))) out.push_back(uint32_t(f));
-  return out;
+  return fiblets_->keptFibers();
 }
 
 void ViewerDissection::startExport(const DissectionState& state, const DissectionExportSource& source,

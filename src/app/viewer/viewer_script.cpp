@@ -10,6 +10,7 @@
 #include "app/render_options.h"
 #include "core/error.h"
 #include "select/cuts.h"
+#include "select/number_list.h"
 #include "select/region.h"
 #include "select/scalar_range.h"
 
@@ -288,11 +289,11 @@ std::variant<ViewerAction, WaitFrames, WaitLoaded, WaitExported, WaitBundled> pa
       if (kind == 1) {
         t.radius_from = std::string(word.substr(5));
       } else if (kind == 2) {
-        const std::string_view range = word.substr(6);
-        const size_t comma = range.find(',');
-        if (comma == std::string_view::npos) throw Error("tubes: expected range=MIN,MAX in mm");
-        t.radius_min = float(number(range.substr(0, comma), "MIN"));
-        t.radius_max = float(number(range.substr(comma + 1), "MAX"));
+        std::vector<double> range;
+        if (!parseNumberList(word.substr(6), range) || range.size() != 2)
+          throw Error("tubes: expected range=MIN,MAX in mm");
+        t.radius_min = float(range[0]);
+        t.radius_max = float(range[1]);
         if (!(t.radius_min > 0.0f) || !(t.radius_max >= t.radius_min))
           throw Error("tubes: the radius range must be > 0 mm and ordered");
       } else {

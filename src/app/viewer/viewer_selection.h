@@ -74,6 +74,7 @@ class ViewerSelection {
   void clear();
   size_t size() const { return entries_.size(); }
   const std::vector<SelectedEntry>& entries() const { return entries_; }  // in selection order
+  uint64_t revision() const { return revision_; }  // changes with every change of entries()
 
   // Writes the selected fibers of ONE model (in selection order) to
   // `tck_path` from its .fbl: the active model's when it has selected

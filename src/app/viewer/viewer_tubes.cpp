@@ -34,11 +34,7 @@ TubeRadius dataRadius(const Tractogram& fibers, const TubesInfo& info) {
   r.radius_max = info.radius_max;
   if (!(r.radius_min > 0.0f) || !(r.radius_max >= r.radius_min))
     throw Error("tubes: the radius range must be > 0 mm and ordered");
-  r.data_min = INFINITY;
-  r.data_max = -INFINITY;
-  for (const float v : fibers.per_streamline.at(0).values)
-    if (std::isfinite(v)) r.data_min = std::min(r.data_min, v), r.data_max = std::max(r.data_max, v);
-  if (r.data_min > r.data_max) r.data_min = r.data_max = 0.0f;  // no finite value: every tube radius_min
+  fitRadiusDataRange(r, fibers.per_streamline.at(0).values);
   return r;
 }
 
@@ -102,11 +98,14 @@ bool ViewerTubes::update(const std::string& key, const std::function<std::vector
       for (const ViewerTubeSource& source : sources()) {
         if (source.fibers.empty()) continue;
         if (!source.fbl) throw Error("tubes: a model's .fbl is not in reach");
-        const Tractogram t = decodeFibers(*source.fbl, source.fibers);
-        for (size_t i = 0; i < t.streamlineCount(); ++i) {
-          job.fibers.addStreamline(t.point(t.offsets[i]), t.pointsIn(i));
-          job.scene_ids.push_back(source.fiber_base + source.fibers[i]);
-        }
+        // In chunks of ~1 M points, each appended once (no whole copy).
+        size_t next = 0;
+        decodeFibers(*source.fbl, source.fibers, size_t(1) << 20, [&](const Tractogram& chunk) {
+          for (size_t i = 0; i < chunk.streamlineCount(); ++i, ++next) {
+            job.fibers.addStreamline(chunk.point(chunk.offsets[i]), chunk.pointsIn(i));
+            job.scene_ids.push_back(source.fiber_base + source.fibers[next]);
+          }
+        });
         if (!info.radius_from.empty()) appendFiberValues(*source.fbl, info.radius_from, source.fibers, job.fibers);
       }
       if (!(info.radius_mm > 0.0f)) throw Error("tubes: the radius must be > 0 mm");

@@ -334,4 +334,12 @@ std::vector<uint32_t> GpuFiberFilter::keptWords() const {
   return words;
 }
 
+std::vector<uint32_t> GpuFiberFilter::keptFibers() const {
+  const std::vector<uint32_t> words = keptWords();
+  std::vector<uint32_t> out;
+  for (uint64_t f = 0; f < fibers_ && f / 32 < words.size(); ++f)
+    if (words[f / 32] & (1u << (f % 32))) out.push_back(uint32_t(f));
+  return out;
+}
+
 }  // namespace fibscope

@@ -91,6 +91,8 @@ class GpuFiberFilter {
   uint32_t fiberCount() const { return fibers_; }
   // The kept words of the last update (downloaded), or empty with no criteria.
   std::vector<uint32_t> keptWords() const;
+  // The kept fibers' ids in order (from keptWords), or empty with no criteria.
+  std::vector<uint32_t> keptFibers() const;
   // With a distance zone (FilterCriteria::distance_zone): each fiber's
   // smallest distance to it, mm (float per scene fiber: a ColorMode::Scalar
   // source); 0 otherwise.
