@@ -269,7 +269,7 @@ void runBench(const BenchOptions& o) {
       SvoGpuBuildOptions build;
       build.progress = true;
       SvoGpuBuildStats svo_stats;
-      const SvoTree tree = buildSvoGpu(*context, model, tubes, chooseSvoGrid(model, o.voxel_mm, k == 1), build,
+      const SvoTree tree = buildSvoGpu(*context, model, tubes, chooseSvoGrid(model, o.voxel_mm, k == 1, svoMemoryLimit(*context, build)), build,
                                        &svo_stats);
       svos[k] = uploadSvo(*context, tree);
       const std::string line = svoBuildSummary(model, tree, svo_stats);
@@ -516,7 +516,7 @@ void addBenchCommand(CLI::App& app) {
                   "--distance 1, close --distance 0.3");
   cmd->add_option("--voxel", o->voxel_mm,
                   "Voxel size of the octree in mm for svo-straight and svo-curved (--pipeline or --compare; default: "
-                  "from the tube radius and the step)");
+                  "from the tube radius and the step, coarser where the octree would not fit the device's memory)");
   cmd->add_option("--frames", o->frames, "Measured frames")->capture_default_str();
   cmd->add_option("--step", o->step_deg, "Orbit step per frame, degrees")->capture_default_str();
   cmd->add_option("--elevation", o->elevation_deg, "Orbit elevation, degrees")->capture_default_str();

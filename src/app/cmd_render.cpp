@@ -172,9 +172,9 @@ void runRender(RenderCommandOptions o) {
                                           filter.active() ? &kept : nullptr);
     tubes = uploadTubes(context, model);
     if (svo) {
-      const SvoGrid grid = chooseSvoGrid(model, o.voxel_mm, svo_curved);
       SvoGpuBuildOptions build;
       build.progress = true;
+      const SvoGrid grid = chooseSvoGrid(model, o.voxel_mm, svo_curved, svoMemoryLimit(context, build));
       const SvoTree tree = buildSvoGpu(context, model, tubes, grid, build, &svo_stats);
       svo_tree = uploadSvo(context, tree);
       svo_line = svoBuildSummary(model, tree, svo_stats);
@@ -273,7 +273,7 @@ void addRenderCommand(CLI::App& app) {
   addTubeCliOptions(cmd, o->tubes);
   cmd->add_option("--voxel", o->voxel_mm,
                   "Voxel size of the octree in mm, with --pipeline svo-straight or svo-curved (default: from the tube radius "
-                  "and the step)")
+                  "and the step, coarser where the octree would not fit the device's memory)")
       ->each([o](const std::string&) { o->voxel_given = true; });
   cmd->add_option("--view", o->view, "sagittal | coronal | axial");
   cmd->add_option("--camera", o->camera, "AZ,EL,DIST: orbit angles in degrees and distance factor (0: framed snugly, 1: the bounding sphere fits)");

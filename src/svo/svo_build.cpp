@@ -120,7 +120,7 @@ void curveBounds(const SvoCurve& c, glm::vec3& lo, glm::vec3& hi) {
   hi = glm::max(glm::max(c.p0, c.p1), glm::max(b1, b2));
 }
 
-SvoGrid chooseSvoGrid(const TubeModel& model, float voxel_mm, bool curved) {
+SvoGrid chooseSvoGrid(const TubeModel& model, float voxel_mm, bool curved, uint64_t memory_limit_bytes) {
   if (!std::isfinite(voxel_mm) || voxel_mm < 0.0f)
     throw Error("svo: the voxel size must be > 0 mm (got " + std::to_string(voxel_mm) + ")");
   if (model.segments.empty()) throw Error("svo: no tube segment to voxelise");
@@ -163,7 +163,9 @@ SvoGrid chooseSvoGrid(const TubeModel& model, float voxel_mm, bool curved) {
       grid.levels = std::max(levels, 1u);
       // Centred on the tubes' box.
       grid.origin = 0.5f * (lo + hi) - 0.5f * float(grid.side()) * voxel;
-      return grid;
+      if (voxel_mm > 0.0f || memory_limit_bytes == 0 ||
+          estimateSvoMemory(model, grid, svoSlabDepth(grid, kSvoDefaultFieldBudget)).total() <= memory_limit_bytes)
+        return grid;
     }
     if (voxel_mm > 0.0f)
       throw Error("svo: a voxel of " + std::to_string(voxel_mm) + " mm needs " + std::to_string(uint64_t(cells)) +
@@ -174,12 +176,31 @@ SvoGrid chooseSvoGrid(const TubeModel& model, float voxel_mm, bool curved) {
   }
 }
 
+uint32_t svoSlabDepth(const SvoGrid& grid, uint64_t field_budget_bytes) {
+  const uint64_t side = grid.side(), plane_bytes = side * side * 4;
+  return uint32_t(std::clamp<uint64_t>(field_budget_bytes / plane_bytes, 1, side));
+}
+
 SvoMemoryNeed estimateSvoMemory(const TubeModel& model, const SvoGrid& grid, uint32_t slab_depth) {
   SvoMemoryNeed need;
   const double h = grid.voxel, band = grid.band();
+  // Bricks of 8^3 voxels touched by a segment's band box, one bit each
+  // (128^3 bits, 256 KB, at the largest grid).
+  const uint32_t brick_shift = std::min(grid.levels, 3u);
+  const uint64_t bricks_side = uint64_t(grid.side()) >> brick_shift;
+  std::vector<uint64_t> touched((bricks_side * bricks_side * bricks_side + 63) / 64, 0);
   double shell = 0.0;
   for (const shader::TubeSegment& s : model.segments) {
     const SvoCapsule c = svoCapsule(model, s);
+    const SegmentShape shape{false, c, {}};
+    glm::ivec3 vlo, vhi;
+    voxelBox(grid, shape, c.radius + float(band), vlo, vhi);
+    for (int z = vlo.z >> brick_shift; z <= vhi.z >> brick_shift; ++z)
+      for (int y = vlo.y >> brick_shift; y <= vhi.y >> brick_shift; ++y)
+        for (int x = vlo.x >> brick_shift; x <= vhi.x >> brick_shift; ++x) {
+          const uint64_t i = (uint64_t(z) * bricks_side + uint64_t(y)) * bricks_side + uint64_t(x);
+          touched[i >> 6] |= uint64_t(1) << (i & 63);
+        }
     const double ro = c.radius + band, ri = std::max(0.0, double(c.radius) - band);
     const double len = glm::length(c.b - c.a);
     // Cylinder shell plus the sphere shell (of the caps, counted once per
@@ -189,8 +210,11 @@ SvoMemoryNeed estimateSvoMemory(const TubeModel& model, const SvoGrid& grid, uin
   // Each segment's own band voxels: the (leaf, segment) references, and an
   // upper bound of the leaves (a leaf holds at least one reference).
   const uint64_t references = uint64_t(std::ceil(shell / (h * h * h))) + 1;
-  need.leaves = references;
+  uint64_t bricks = 0;
+  for (const uint64_t word : touched) bricks += uint64_t(__builtin_popcountll(word));
   const uint64_t side = grid.side();
+  need.references = references;
+  need.leaves = std::min({references, bricks << (3 * brick_shift), side * side * side});
   need.field = side * side * std::min<uint64_t>(slab_depth, side) * 4;
   need.sort = need.leaves * 4 * 4;
   need.nodes = need.leaves * 8 * 8 / 7 + 8;

@@ -86,12 +86,30 @@ void curveBounds(const SvoCurve& c, glm::vec3& lo, glm::vec3& hi);
 // when voxel_mm < 0 or not finite, the model has no segment, or a given
 // voxel needs more than 2^kSvoMaxLevels voxels a side (naming the side).
 // `curved`: the box of the curved segments (curveBounds), and the grid's
-// `curved` flag set.
-SvoGrid chooseSvoGrid(const TubeModel& model, float voxel_mm, bool curved = false);
+// `curved` flag set. `memory_limit_bytes` > 0 with voxel_mm 0 (the
+// density criterion, the seed's future work): the voxel is coarsened
+// further by 1.25x until estimateSvoMemory (at svoSlabDepth's slabs of
+// kSvoDefaultFieldBudget) fits the limit, so a dense whole-brain set gets a
+// voxel its device can hold instead of a refusal; a given voxel is never
+// changed (the build refuses it, naming the size it needs).
+SvoGrid chooseSvoGrid(const TubeModel& model, float voxel_mm, bool curved = false, uint64_t memory_limit_bytes = 0);
+
+// The dense distance slab of a build at most this large by default
+// (SvoGpuBuildOptions::field_budget_bytes), and the slab depth (voxels of
+// z) a budget gives on `grid`: at least 1, at most the side.
+inline constexpr uint64_t kSvoDefaultFieldBudget = uint64_t(64) << 20;
+uint32_t svoSlabDepth(const SvoGrid& grid, uint64_t field_budget_bytes);
 
 // What a build will allocate, estimated before allocating (bytes).
 struct SvoMemoryNeed {
-  uint64_t leaves = 0;      // narrow-band voxels, bounded by the sum of every capsule's band shell / voxel^3
+  // Narrow-band voxels at most: the smallest of the (leaf, segment)
+  // references' bound below (a leaf holds at least one), the voxels of the
+  // 8^3-voxel bricks that some segment's band box touches, and the grid.
+  // The references' bound, the sum of every capsule's band shell /
+  // voxel^3, ignores overlap: in dense bundles the voxels deep inside the
+  // union are no leaves, so it is an upper bound there, never short.
+  uint64_t leaves = 0;
+  uint64_t references = 0;
   uint64_t field = 0;       // the GPU's dense distance slab
   uint64_t sort = 0;        // leaf keys and values, twice (the sort's ping-pong)
   uint64_t nodes = 0;       // tree, about 8/7 of the leaves' blocks

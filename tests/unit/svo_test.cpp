@@ -51,6 +51,41 @@ TEST(SvoGridRule, voxelIsHalfTheRadiusAndRejectsBadSizes) {
   }
 }
 
+// The estimate a build checks before allocating is an upper bound of what
+// the build makes (leaves, references, node and decoration bytes), and the
+// brick bound makes the leaves' part tight enough to matter: on a dense
+// bundle it is below the references' (shell) bound, which ignores overlap.
+TEST(SvoMemoryEstimate, boundsTheBuildAndTheDensityCriterionFitsTheLimit) {
+  // 150 fibers of radius 0.3 mm within a 2.7 mm radius: the tubes overlap.
+  const TubeModel model = buildTubes(test::denseSvoBundle(150), test::svoTubeOptions(0.3f));
+  for (const float voxel : {0.0f, 0.1f}) {
+    const SvoGrid grid = chooseSvoGrid(model, voxel);
+    const SvoMemoryNeed need = estimateSvoMemory(model, grid, svoSlabDepth(grid, kSvoDefaultFieldBudget));
+    const SvoTree tree = buildSvoCpu(model, grid);
+    SCOPED_TRACE(grid.voxel);
+    EXPECT_GE(need.leaves, tree.leaves);
+    EXPECT_GE(need.references, tree.references);
+    EXPECT_GE(need.nodes, tree.nodeBytes());
+    EXPECT_GE(need.decoration, tree.decorationBytes());
+    EXPECT_LT(need.leaves, need.references);
+  }
+  // A limit below the rule's voxel's need: the chosen voxel is coarser, by
+  // steps of 1.25x, and its estimate fits; a given voxel is kept.
+  const SvoGrid fine = chooseSvoGrid(model, 0.0f);
+  const uint64_t fine_need = estimateSvoMemory(model, fine, svoSlabDepth(fine, kSvoDefaultFieldBudget)).total();
+  const SvoGrid fitted = chooseSvoGrid(model, 0.0f, false, fine_need / 4);
+  EXPECT_GT(fitted.voxel, fine.voxel * 1.2f);
+  EXPECT_LE(estimateSvoMemory(model, fitted, svoSlabDepth(fitted, kSvoDefaultFieldBudget)).total(), fine_need / 4);
+  const SvoGrid coarser = SvoGrid{fitted.origin, fitted.voxel / 1.25f, fitted.levels};
+  if (coarser.voxel > fine.voxel * 1.01f) {
+    const SvoGrid prev = chooseSvoGrid(model, coarser.voxel);
+    EXPECT_GT(estimateSvoMemory(model, prev, svoSlabDepth(prev, kSvoDefaultFieldBudget)).total(), fine_need / 4)
+        << "the voxel one step finer would have fitted";
+  }
+  EXPECT_FLOAT_EQ(chooseSvoGrid(model, 0.1f, false, fine_need / 4).voxel, 0.1f);
+  EXPECT_FLOAT_EQ(chooseSvoGrid(model, 0.0f, false, fine_need).voxel, fine.voxel);
+}
+
 // Descends from the root by the code's octants.
 const shader::SvoNode* findLeaf(const SvoTree& tree, uint32_t code) {
   uint32_t node = 0;

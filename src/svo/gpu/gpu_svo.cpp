@@ -96,15 +96,16 @@ void recordRadixSort(const gpu::VulkanContext& context, VkCommandBuffer cmd, con
   }
 }
 
-uint64_t deviceLocalHeapBytes(const gpu::VulkanContext& context) {
+}  // namespace
+
+uint64_t svoMemoryLimit(const gpu::VulkanContext& context, const SvoGpuBuildOptions& options) {
+  if (options.memory_limit_bytes) return options.memory_limit_bytes;
   const VkPhysicalDeviceMemoryProperties& m = context.memoryProperties();
   uint64_t largest = 0;
   for (uint32_t i = 0; i < m.memoryHeapCount; ++i)
     if (m.memoryHeaps[i].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT) largest = std::max(largest, m.memoryHeaps[i].size);
   return largest;
 }
-
-}  // namespace
 
 void gpuRadixSort(const gpu::VulkanContext& context, std::vector<uint32_t>& keys, std::vector<uint32_t>& values,
                   uint32_t bits) {
@@ -151,12 +152,11 @@ std::vector<SvoLeaf> voxelizeSvoLeavesGpu(const gpu::VulkanContext& context, con
   SvoGpuBuildStats local;
   SvoGpuBuildStats& st = stats ? *stats : local;
   const uint64_t side = grid.side();
-  const uint64_t plane_bytes = side * side * 4;
-  const uint32_t slab_depth = uint32_t(std::clamp<uint64_t>(options.field_budget_bytes / plane_bytes, 1, side));
+  const uint32_t slab_depth = svoSlabDepth(grid, options.field_budget_bytes);
   st.slab_depth = slab_depth;
   st.slabs = uint32_t((side + slab_depth - 1) / slab_depth);
   st.need = estimateSvoMemory(model, grid, slab_depth);
-  const uint64_t limit = options.memory_limit_bytes ? options.memory_limit_bytes : deviceLocalHeapBytes(context);
+  const uint64_t limit = svoMemoryLimit(context, options);
   if (st.need.total() > limit)
     throw Error("svo: the octree of " + std::to_string(model.segments.size()) + " segments at a voxel of " +
                 std::to_string(grid.voxel) + " mm needs about " + megabytes(st.need.total()) + " (distance slab " +

@@ -37,7 +37,7 @@ void recordSvoVoxelize(const gpu::VulkanContext& context, VkCommandBuffer cmd, c
                        const GpuTubes& tubes, shader::SvoVoxelizePush push);
 
 struct SvoGpuBuildOptions {
-  uint64_t field_budget_bytes = 64ull << 20;  // the dense slab's size at most (decides the slab depth)
+  uint64_t field_budget_bytes = kSvoDefaultFieldBudget;  // the dense slab's size at most (decides the slab depth)
   // 0: the device's largest device-local heap. The build throws before
   // allocating anything when its estimate (estimateSvoMemory) exceeds it.
   uint64_t memory_limit_bytes = 0;
@@ -51,6 +51,11 @@ struct SvoGpuBuildStats {
   double voxelize_s = 0, sort_s = 0, tree_s = 0;  // wall time (host clock around each step)
   SvoMemoryNeed need;
 };
+
+// The memory a build may use: options.memory_limit_bytes, else the
+// device's largest device-local heap (what chooseSvoGrid's density
+// criterion is given).
+uint64_t svoMemoryLimit(const gpu::VulkanContext& context, const SvoGpuBuildOptions& options = {});
 
 // The leaves (|f| < band) of `tubes`' capsules on `grid`, voxelised and
 // sorted on the device, in Morton order.
