@@ -548,5 +548,52 @@ TEST_F(GpuSvoTrace, benchmarkAgainstEmbreeWhenAsked) {
 #endif
 }
 
+// The seed's table 2 on this device (figures, not a check): runs only with
+// FIBSCOPE_SVO_TABLE2=A.tck,B.tck,... (scripts/svo_table1.sh keeps its
+// bundles with KEEP=1). Per file: svo-straight and svo-curved built by the
+// voxel rule and traced at FIBSCOPE_SVO_TABLE2_SIZE (1920x1080) with
+// FIBSCOPE_SVO_TABLE2_RADIUS (0.5 mm), the trace pass's GPU timestamps
+// (second frame), and Embree's scene build plus one ray per pixel of the
+// same image on one thread of the same CPU (host clock): a ratio from one
+// run.
+TEST_F(GpuSvoTrace, table2WhenAsked) {
+  const char* files = std::getenv("FIBSCOPE_SVO_TABLE2");
+  if (!files) GTEST_SKIP() << "set FIBSCOPE_SVO_TABLE2=A.tck,B.tck to measure";
+  REQUIRE_EMBREE();
+#if FIBSCOPE_HAVE_EMBREE
+  using Clock = std::chrono::steady_clock;
+  uint32_t width = 1920, height = 1080;
+  if (const char* size = std::getenv("FIBSCOPE_SVO_TABLE2_SIZE"))
+    ASSERT_EQ(std::sscanf(size, "%ux%u", &width, &height), 2) << size;
+  const char* radius_text = std::getenv("FIBSCOPE_SVO_TABLE2_RADIUS");
+  const float radius = radius_text ? std::strtof(radius_text, nullptr) : 0.5f;
+  std::printf("| file | segments | size | svo-straight trace ms | svo-curved trace ms | Embree build + trace ms | "
+              "straight / Embree |\n");
+  std::string list = files;
+  for (size_t at = 0; at <= list.size();) {
+    const size_t comma = std::min(list.find(',', at), list.size());
+    const std::string path = list.substr(at, comma - at);
+    at = comma + 1;
+    if (path.empty()) continue;
+    const Tractogram t = readAllStreamlines(*openTractogram(path));
+    const TubeModel model = buildTubes(t, test::svoTubeOptions(radius));
+    const Camera camera = test::svoCamera(t, 0.4, -1.0, 0.5, width, height);
+    double ms[2] = {0, 0};
+    for (const bool curved : {false, true}) {
+      SvoGpuBuildStats st;
+      SvoTree tree;
+      ms[curved] = buildAndTraceMs(context(), model, chooseSvoGrid(model, 0.0f, curved, svoMemoryLimit(context())),
+                                   camera, tree, st);
+    }
+    const auto e0 = Clock::now();
+    traceEmbree(model, camera);
+    const double embree_ms = std::chrono::duration<double, std::milli>(Clock::now() - e0).count();
+    std::printf("| %s | %zu | %ux%u | %.1f | %.1f | %.1f | %.2f |\n", path.c_str(), model.segments.size(), width, height,
+                ms[0], ms[1], embree_ms, ms[0] / embree_ms);
+    std::fflush(stdout);
+  }
+#endif
+}
+
 }  // namespace
 }  // namespace fibscope
