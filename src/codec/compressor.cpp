@@ -31,6 +31,10 @@ struct ChunkJob {
   std::vector<float> lengths;  // arc length of each input fiber, mm
   uint64_t encoded_points = 0;
   ResampleReport resample;
+  // With resampling: the input's per-point arrays at the resampled points
+  // (resampleToStep's interpolation), in the input's order; else empty (the
+  // input's own values are the encoded points').
+  std::vector<DataArray> resampled_per_point;
 };
 
 void encodeChunk(FibletEncoder& encoder, ChunkJob& job, bool resample, double delta_mm) {
@@ -47,10 +51,11 @@ void encodeChunk(FibletEncoder& encoder, ChunkJob& job, bool resample, double de
     job.lengths[s] = polylineLength(in.point(in.offsets[s]), in.pointsIn(s));
   job.fiblets.record_bytes = encoder.decoder().params().recordBytes();
   if (resample) {
-    const Tractogram resampled = resampleToStep(in, delta_mm, &job.resample);
+    Tractogram resampled = resampleToStep(in, delta_mm, &job.resample);
     checkLengths(resampled);
     encoder.encode(resampled, job.fiblets);
     job.encoded_points = resampled.pointCount();
+    job.resampled_per_point = std::move(resampled.per_point);
   } else {
     checkLengths(in);
     encoder.encode(in, job.fiblets);
@@ -58,8 +63,10 @@ void encodeChunk(FibletEncoder& encoder, ChunkJob& job, bool resample, double de
   }
 }
 
-// Whether `name` can be a section name "dps/<name>" (FblWriter's rules).
+// Whether `name` can be a section name "dps/<name>" or "dpv/<name>"
+// (FblWriter's rules; both prefixes are 4 bytes).
 bool storableArrayName(const std::string& name) {
+  static_assert(kFblSectionDpsPrefix.size() == kFblSectionDpvPrefix.size());
   if (name.empty() || name.size() + kFblSectionDpsPrefix.size() > 47) return false;
   for (unsigned char c : name)
     if (c < 0x20 || c == 0x7f) return false;
@@ -142,26 +149,46 @@ CompressReport compressTractogram(const ReaderFactory& open_input, const std::st
                                "\" (name unusable as a section name)");
     }
   }
-  for (const DataArray& a : header.per_point)
-    report.dropped.push_back("per-point array \"" + a.name + "\" (fiblets carry positions only)");
+  stored.per_point.clear();
+  std::vector<size_t> stored_point_arrays;  // indices into the chunks' per_point
+  std::vector<DataArray> dropped_point_arrays;
+  for (size_t a = 0; a < header.per_point.size(); ++a) {
+    if (storableArrayName(header.per_point[a].name)) {
+      stored_point_arrays.push_back(a);
+      stored.per_point.push_back(header.per_point[a]);
+    } else {
+      dropped_point_arrays.push_back(header.per_point[a]);
+      report.dropped.push_back("per-point array \"" + header.per_point[a].name +
+                               "\" (name unusable as a section name)");
+    }
+  }
   if (!header.groups.empty())
     report.dropped.push_back(std::to_string(header.groups.size()) + " TRX groups (not stored in .fbl version 1)");
 
   // Pass 2: encode.
   const auto encode_start = Clock::now();
   reader = open_input();
-  if (reader->header().per_streamline.size() != header.per_streamline.size())
+  if (reader->header().per_streamline.size() != header.per_streamline.size() ||
+      reader->header().per_point.size() != header.per_point.size())
     fail(header.path, "changed between the two passes of compression");
   std::string directory = std::filesystem::path(output).parent_path().string();
   if (directory.empty()) directory = ".";
   // The section table holds exactly the sections written (fiblets, two
-  // fiber tables, the per-fiber arrays, source): on small files a spare
-  // table is a visible part of the bytes per point.
-  FblWriter writer(output, fblHeaderFor(params), options.overwrite, uint32_t(4 + stored_arrays.size()));
+  // fiber tables, the per-fiber arrays, with per-point arrays their table
+  // of first points and the arrays, source): on small files a spare table
+  // is a visible part of the bytes per point.
+  const bool point_data = !stored_point_arrays.empty();
+  FblWriter writer(output, fblHeaderFor(params), options.overwrite,
+                   uint32_t(4 + stored_arrays.size() + (point_data ? 1 + stored_point_arrays.size() : 0)));
   SpillFile first_fiblets(directory, "fiber table");
   SpillFile lengths(directory, "fiber lengths");
   std::vector<SpillFile> arrays;
   for (size_t a = 0; a < stored_arrays.size(); ++a) arrays.emplace_back(directory, "per-streamline data");
+  SpillFile first_points(directory, "fiber point table");
+  std::vector<SpillFile> point_arrays;
+  for (size_t a = 0; a < stored_point_arrays.size(); ++a) point_arrays.emplace_back(directory, "per-point data");
+  uint64_t point_base = 0;  // encoded points of the chunks written
+  std::vector<uint64_t> point_firsts;
 
   const unsigned threads = options.threads ? options.threads : ThreadPool::hardwareThreads();
   report.threads = threads;
@@ -200,6 +227,23 @@ CompressReport compressTractogram(const ReaderFactory& open_input, const std::st
         const std::vector<float>& values = job->input.per_streamline[stored_arrays[a]].values;
         arrays[a].write(values.data(), values.size() * sizeof(float));
       }
+      if (point_data) {
+        point_firsts.resize(f.fiber_points.size());
+        for (size_t i = 0; i < point_firsts.size(); ++i) {
+          point_firsts[i] = point_base;
+          point_base += f.fiber_points[i];
+        }
+        first_points.write(point_firsts.data(), point_firsts.size() * sizeof(uint64_t));
+        const std::vector<DataArray>& per_point =
+            options.resample ? job->resampled_per_point : job->input.per_point;
+        for (size_t a = 0; a < stored_point_arrays.size(); ++a) {
+          const DataArray& array = per_point.at(stored_point_arrays[a]);
+          if (array.values.size() != job->encoded_points * array.components)
+            fail(header.path, "per-point array \"" + array.name + "\" holds " + std::to_string(array.values.size()) +
+                                  " values for " + std::to_string(job->encoded_points) + " points");
+          point_arrays[a].write(array.values.data(), array.values.size() * sizeof(float));
+        }
+      }
       fiblet_base += f.fibletCount();
       report.fibers += job->input.streamlineCount();
       report.points += job->encoded_points;
@@ -210,6 +254,7 @@ CompressReport compressTractogram(const ReaderFactory& open_input, const std::st
       job->fiblets.fiber_first_fiblet.clear();
       job->fiblets.fiber_points.clear();
       job->resample = {};
+      job->resampled_per_point.clear();
       spare.push_back(std::move(job));
     };
     for (;;) {
@@ -257,7 +302,16 @@ CompressReport compressTractogram(const ReaderFactory& open_input, const std::st
     const DataArray& array = header.per_streamline[stored_arrays[a]];
     copySection(arrays[a], std::string(kFblSectionDpsPrefix) + array.name, FblDType::kFloat32, array.components);
   }
-  const std::string source = fblSourceJson(stored);
+  if (point_data) {
+    first_points.write(&point_base, sizeof point_base);  // the end of the last fiber
+    copySection(first_points, std::string(kFblSectionFiberFirstPoint), FblDType::kUint64, 1);
+    for (size_t a = 0; a < stored_point_arrays.size(); ++a) {
+      const DataArray& array = header.per_point[stored_point_arrays[a]];
+      copySection(point_arrays[a], std::string(kFblSectionDpvPrefix) + array.name, FblDType::kFloat32,
+                  array.components);
+    }
+  }
+  const std::string source = fblSourceJson(stored, dropped_point_arrays);
   writer.writeSection({std::string(kFblSectionSource), FblDType::kUtf8, 1}, source.data(), source.size());
 
   FblHeaderFields& fields = writer.fields();

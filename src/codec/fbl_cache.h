@@ -46,7 +46,8 @@ namespace fibscope {
 // Bump when the phantom generator's output for the same options changes.
 inline constexpr uint32_t kPhantomGeneratorVersion = 1;
 // Bump when the key's fields or their meaning change.
-inline constexpr uint32_t kFblCacheKeyVersion = 1;
+// 2: per-point arrays are stored (dpv sections); older entries lack them.
+inline constexpr uint32_t kFblCacheKeyVersion = 2;
 
 inline constexpr size_t kFblCacheSampleBlocks = 16;
 inline constexpr uint64_t kFblCacheSampleBlockBytes = uint64_t(64) << 10;

@@ -66,7 +66,7 @@ nlohmann::json arraysJson(const std::vector<DataArray>& arrays) {
 
 }  // namespace
 
-std::string fblSourceJson(const TractogramHeader& h) {
+std::string fblSourceJson(const TractogramHeader& h, const std::vector<DataArray>& dropped_per_point) {
   nlohmann::json j;
   j["path"] = h.path;
   j["format"] = h.format;
@@ -83,9 +83,8 @@ std::string fblSourceJson(const TractogramHeader& h) {
   for (const auto& [key, value] : h.properties) properties.push_back({key, value});
   j["properties"] = properties;
   j["per_streamline"] = arraysJson(h.per_streamline);
-  // Per-point arrays are not stored (fiblets carry positions only); listed
-  // so that `info` can say what was dropped.
-  j["dropped_per_point"] = arraysJson(h.per_point);
+  j["per_point"] = arraysJson(h.per_point);
+  j["dropped_per_point"] = arraysJson(dropped_per_point);
   // Dumped with replacement of invalid UTF-8 (tck keys are raw bytes).
   return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
@@ -109,8 +108,9 @@ TractogramHeader headerFromFblSource(std::string_view text, const std::string& f
     if (j.contains("properties"))
       for (const auto& kv : j.at("properties"))
         h.properties.emplace_back(kv.at(0).get<std::string>(), kv.at(1).get<std::string>());
-    if (j.contains("per_streamline"))
-      for (const auto& a : j.at("per_streamline")) {
+    const auto arrays = [&](const char* key, std::vector<DataArray>& out) {
+      if (!j.contains(key)) return;
+      for (const auto& a : j.at(key)) {
         DataArray array;
         array.name = a.at("name").get<std::string>();
         array.components = a.at("components").get<uint32_t>();
@@ -120,8 +120,13 @@ TractogramHeader headerFromFblSource(std::string_view text, const std::string& f
           fail(fbl_path, "section source: array " +
                              a.at("name").dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + " has " +
                              std::to_string(array.components) + " components");
-        h.per_streamline.push_back(std::move(array));
+        out.push_back(std::move(array));
       }
+    };
+    arrays("per_streamline", h.per_streamline);
+    // Files written before per-point arrays were stored list them as
+    // "dropped_per_point": those are not read back.
+    arrays("per_point", h.per_point);
   } catch (const nlohmann::json::exception& e) {
     // nlohmann messages are one line; keep them short.
     fail(fbl_path, std::string("section source: ") + e.what());

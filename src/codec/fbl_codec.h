@@ -33,13 +33,15 @@ CodecParams roundTripThroughFbl(const CodecParams& params);
 // JSON text of the "source" section: input path, format, declared counts,
 // voxel space, header properties (tck keys, trk fields, TRX extras), and the
 // names/components/dtypes of the per-streamline arrays stored as "dps/<name>"
-// sections.
-std::string fblSourceJson(const TractogramHeader& header);
+// sections and of the per-point arrays stored as "dpv/<name>" sections
+// (header.per_point), and those of `dropped_per_point` (arrays of the input
+// that were not stored, for `info`).
+std::string fblSourceJson(const TractogramHeader& header, const std::vector<DataArray>& dropped_per_point = {});
 
 // The header of a decompressed tractogram, from the "source" JSON: format,
-// space, properties and per-streamline array descriptions of the original;
-// path = `fbl_path`, file_bytes 0, declared counts -1, no per-point arrays
-// (fiblets do not carry them). Throws Error naming `fbl_path` when the JSON
+// space, properties, per-streamline and stored per-point array
+// descriptions of the original; path = `fbl_path`, file_bytes 0, declared
+// counts -1. Throws Error naming `fbl_path` when the JSON
 // is malformed or a field has the wrong type.
 TractogramHeader headerFromFblSource(std::string_view json, const std::string& fbl_path);
 

@@ -393,9 +393,11 @@ FblFile FblFile::open(const std::string& path) {
   };
   for (const FblSection& s : f.sections_) {
     const std::string_view name = s.name;
-    if (name == kFblSectionFiberFirstFiblet) {
+    if (name == kFblSectionFiberFirstFiblet || name == kFblSectionFiberFirstPoint) {
       if (f.fields_.fiber_count == UINT64_MAX) fail(path, "header: fiber count 2^64-1 is not possible");
       checkCount(s, f.fields_.fiber_count + 1, "fiber count + 1");
+    } else if (name.starts_with(kFblSectionDpvPrefix)) {
+      checkCount(s, f.fields_.point_count, "one per point");
     } else if (name == kFblSectionFiberLength || name.starts_with(kFblSectionDpsPrefix)) {
       checkCount(s, f.fields_.fiber_count, "one per fiber");
     } else if (name == kFblSectionFiblets) {

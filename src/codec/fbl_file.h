@@ -58,6 +58,11 @@ inline constexpr std::string_view kFblSectionFiblets = "fiblets";               
 inline constexpr std::string_view kFblSectionFiberFirstFiblet = "fiber_first_fiblet";  // uint64 x (fibers + 1)
 inline constexpr std::string_view kFblSectionFiberLength = "fiber_length_mm";          // float32 per fiber
 inline constexpr std::string_view kFblSectionDpsPrefix = "dps/";  // "dps/<name>": float32 x components per fiber
+// Per-point data (optional; both or neither): "dpv/<name>" float32 x
+// components per encoded point, in the fibers' order, and the index of each
+// fiber's first point in them.
+inline constexpr std::string_view kFblSectionDpvPrefix = "dpv/";
+inline constexpr std::string_view kFblSectionFiberFirstPoint = "fiber_first_point";  // uint64 x (fibers + 1)
 inline constexpr std::string_view kFblSectionSource = "source";   // utf8 JSON: input path, format, header
 
 // Header fields owned by the codec; the container stores them verbatim.

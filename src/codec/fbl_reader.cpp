@@ -70,6 +70,8 @@ class FblReader final : public TractogramReader {
   std::span<const uint8_t> records_;
   std::span<const uint64_t> first_fiblet_;   // fiber_count + 1 entries
   std::vector<std::span<const float>> dps_;  // parallel to header_.per_streamline
+  std::vector<std::span<const float>> dpv_;  // parallel to header_.per_point
+  std::span<const uint64_t> first_point_;    // fiber_count + 1 entries, with dpv sections only
   uint64_t fiber_count_ = 0;
   uint64_t fiblet_count_ = 0;
   uint64_t point_count_ = 0;  // the header's
@@ -125,6 +127,7 @@ FblReader::FblReader(const std::string& path, DecodeOrder order)
   header_.space = std::move(original.space);
   header_.properties = std::move(original.properties);
   header_.per_streamline = std::move(original.per_streamline);
+  header_.per_point = std::move(original.per_point);
   header_.file_bytes = file_.fileBytes();
   // Both fit: the table has fiber_count + 1 entries of 8 bytes in the file,
   // and point_count <= 60 * fiblet_count was checked above.
@@ -149,6 +152,28 @@ FblReader::FblReader(const std::string& path, DecodeOrder order)
   for (const FblSection& s : file_.sections())
     if (std::string_view(s.name).starts_with(kFblSectionDpsPrefix) && !listed.contains(s.name))
       fail(header_.path, "section " + quoted(s.name) + " is not among the per-streamline arrays of the source JSON");
+
+  // Likewise the per-point arrays, and their table of first points (its
+  // entries are checked against the decoded counts fiber by fiber).
+  for (const DataArray& a : header_.per_point) {
+    const std::string name = std::string(kFblSectionDpvPrefix) + a.name;
+    if (!listed.insert(name).second) failIn(kFblSectionSource, "per-point array " + quoted(a.name) + " listed twice");
+    const FblSection* s = file_.find(name);
+    if (!s) failIn(kFblSectionSource, "per-point array " + quoted(a.name) + " has no section " + quoted(name));
+    if (s->components != a.components)
+      fail(header_.path, "section " + quoted(name) + ": " + str(s->components) + " components, the source JSON says " +
+                             str(a.components));
+    dpv_.push_back(file_.array<float>(*s));  // one element per point: FblFile::open
+  }
+  for (const FblSection& s : file_.sections())
+    if (std::string_view(s.name).starts_with(kFblSectionDpvPrefix) && !listed.contains(s.name))
+      fail(header_.path, "section " + quoted(s.name) + " is not among the per-point arrays of the source JSON");
+  if (!dpv_.empty()) {
+    first_point_ = file_.array<uint64_t>(requireSection(kFblSectionFiberFirstPoint, FblDType::kUint64));
+    if (first_point_.back() != point_count_)
+      failIn(kFblSectionFiberFirstPoint,
+             "last entry " + str(first_point_.back()) + ", expected the point count " + str(point_count_) + " (header)");
+  }
 }
 
 const FblSection& FblReader::requireSection(std::string_view name, FblDType dtype) const {
@@ -222,6 +247,10 @@ bool FblReader::read(Tractogram& chunk, size_t max_points) {
     if (n > point_count_ - points_)
       fail(header_.path,
            "header: " + str(point_count_) + " points, but fibers 0.." + str(fiber_) + " hold " + str(points_ + n));
+    if (!first_point_.empty() && (first_point_[fiber_] != points_ || first_point_[fiber_ + 1] != points_ + n))
+      failIn(kFblSectionFiberFirstPoint, "fiber " + str(fiber_) + " spans points " + str(first_point_[fiber_]) + ".." +
+                                             str(first_point_[fiber_ + 1]) + ", but its fiblets hold points " +
+                                             str(points_) + ".." + str(points_ + n));
     const size_t at = chunk.positions.size();
     chunk.positions.resize(at + 3 * size_t(n));
     decodeFiber(first, last, chunk.positions.data() + at);
@@ -234,6 +263,11 @@ bool FblReader::read(Tractogram& chunk, size_t max_points) {
   for (size_t a = 0; a < dps_.size(); ++a) {
     const size_t k = header_.per_streamline[a].components;
     chunk.per_streamline[a].values.assign(dps_[a].begin() + first_fiber * k, dps_[a].begin() + fiber_ * k);
+  }
+  // points_ <= point_count_ (checked per fiber above), the arrays' length.
+  for (size_t a = 0; a < dpv_.size(); ++a) {
+    const size_t k = header_.per_point[a].components;
+    chunk.per_point[a].values.assign(dpv_[a].begin() + (points_ - points) * k, dpv_[a].begin() + points_ * k);
   }
   if (fiber_ == fiber_count_ && points_ != point_count_)
     fail(header_.path, "header: " + str(point_count_) + " points, but the fibers hold " + str(points_));

@@ -21,10 +21,12 @@ inline constexpr uint64_t kFblMaxFiberPoints = uint64_t(1) << 24;
 // fiblet records in "fiblets", "fiber_first_fiblet", per-fiber "dps/<name>"
 // arrays and the "source" JSON.
 //
-// header(): format, space, properties and per-streamline arrays of the
-// original file (from "source"), path = `path`, file_bytes = the .fbl's
-// size, declared_streamlines / declared_points = the header's fiber and
-// point counts. No per-point arrays (fiblets carry positions only).
+// header(): format, space, properties, per-streamline and per-point arrays
+// of the original file (from "source"), path = `path`, file_bytes = the
+// .fbl's size, declared_streamlines / declared_points = the header's fiber
+// and point counts. Per-point arrays ("dpv/<name>", one value per encoded
+// point: resampled with the points when the file was) come with the
+// "fiber_first_point" table, whose entries must match the decoded counts.
 //
 // read() decodes whole fibers, about max_points points a chunk, in `order`
 // (by default Sequential: the points the compression report measured, and

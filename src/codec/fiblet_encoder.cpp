@@ -413,6 +413,18 @@ Tractogram resampleToStep(const Tractogram& in, double step_mm, ResampleReport* 
   if (!(step_mm > 0) || !std::isfinite(step_mm)) fail("resample", "step must be finite and > 0");
   Tractogram out;
   out.per_streamline = in.per_streamline;
+  out.per_point.reserve(in.per_point.size());
+  for (const DataArray& a : in.per_point) out.per_point.push_back(DataArray{a.name, a.components, a.dtype, {}});
+  // The per-point values at the point u of the way from input point i to
+  // i + 1 (linear, as the position).
+  const auto emitValues = [&](size_t i, double u) {
+    for (size_t a = 0; a < in.per_point.size(); ++a) {
+      const uint32_t k = in.per_point[a].components;
+      const float* v = in.per_point[a].values.data() + i * k;
+      for (uint32_t c = 0; c < k; ++c)
+        out.per_point[a].values.push_back(u == 0.0 ? v[c] : float((1.0 - u) * double(v[c]) + u * double(v[k + c])));
+    }
+  };
   ResampleReport counts;
   counts.input_points = in.pointCount();
   double deviation_sum = 0;
@@ -434,7 +446,11 @@ Tractogram resampleToStep(const Tractogram& in, double step_mm, ResampleReport* 
     if (length / step_mm > double(kMaxResampledPoints))
       fail("resample", "streamline " + std::to_string(s) + " is " + std::to_string(length) + " mm long, more than " +
                            std::to_string(kMaxResampledPoints) + " steps of " + std::to_string(step_mm) + " mm");
-    if (n > 0) out.positions.insert(out.positions.end(), p, p + 3);
+    const size_t first_point = size_t(in.offsets[s]);
+    if (n > 0) {
+      out.positions.insert(out.positions.end(), p, p + 3);
+      emitValues(first_point, 0.0);
+    }
     if (n >= 2) {
       glm::dvec3 cur(p[0], p[1], p[2]);
       // Input vertices passed since the last output point: they lie between
@@ -475,13 +491,17 @@ Tractogram resampleToStep(const Tractogram& in, double step_mm, ResampleReport* 
         const glm::dvec3 previous = cur;
         cur = pa + u * d;
         for (int c = 0; c < 3; ++c) out.positions.push_back(float(cur[c]));
+        emitValues(first_point + seg, u);
         measure(previous, cur);
         ++counts.moved_points;
       }
       const float* last = p + 3 * (n - 1);
       const glm::dvec3 end(last[0], last[1], last[2]);
       const double gap2 = glm::dot(end - cur, end - cur);
-      if (gap2 > 0) out.positions.insert(out.positions.end(), last, last + 3);
+      if (gap2 > 0) {
+        out.positions.insert(out.positions.end(), last, last + 3);
+        emitValues(first_point + n - 1, 0.0);
+      }
       measure(cur, end);
     }
     out.offsets.push_back(out.positions.size() / 3);

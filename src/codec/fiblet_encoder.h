@@ -196,8 +196,9 @@ struct ResampleReport {
 // (chord length, the step the decoder uses): each new point is where the
 // sphere of radius step_mm around the previous one leaves the polyline. The
 // first and last input points are kept; the last segment is shorter (the
-// encoder stores it as a step exception). Per-point data arrays are dropped
-// (their samples no longer match). Throws Error when step_mm is not finite
+// encoder stores it as a step exception). Per-point data arrays are
+// interpolated linearly between the two input points around each new point
+// (by its parameter on that segment, as the position). Throws Error when step_mm is not finite
 // and > 0, a coordinate is not finite, or a streamline would need more than
 // 2^31 points.
 Tractogram resampleToStep(const Tractogram& tractogram, double step_mm, ResampleReport* report = nullptr);

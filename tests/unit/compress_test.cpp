@@ -18,6 +18,7 @@
 #include "codec/compressor.h"
 #include "codec/direction_quantizer.h"
 #include "codec/fbl_file.h"
+#include "codec/fbl_reader.h"
 #include "core/error.h"
 #include "core/spill_file.h"
 #include "core/thread_pool.h"
@@ -260,6 +261,50 @@ TEST(Compressor, fiberTablesLengthsAndPerFiberDataAreStored) {
   ASSERT_EQ(original.per_streamline.size(), 1u);
   EXPECT_TRUE(std::equal(values.begin(), values.end(), original.per_streamline[0].values.begin()));
   EXPECT_NE(f.find(kFblSectionSource), nullptr);
+}
+
+// A per-point array whose values are each point's x coordinate: stored as
+// given without resampling, and interpolated with the points when they are
+// resampled, so the value stays the x of the point it belongs to (within
+// the codec's error, the only difference between the encoded and the
+// decoded point).
+TEST(Compressor, perPointArraysAreStoredAndResampledWithThePoints) {
+  TempDir dir;
+  const Tractogram full = readAllStreamlines(*phantomReader(30, 0.3));
+  Tractogram t;
+  t.per_point.push_back({"x", 1, "float32", {}});
+  for (size_t s = 0; s < full.streamlineCount(); ++s) {
+    std::vector<float> xyz;
+    for (size_t i = 0; i < full.pointsIn(s); ++i)
+      if (i % 5 != 2 || i + 1 == full.pointsIn(s)) {  // uneven steps: resampling moves points
+        const float* p = full.point(full.offsets[s] + i);
+        xyz.insert(xyz.end(), p, p + 3);
+        t.per_point[0].values.push_back(p[0]);
+      }
+    t.addStreamline(xyz.data(), xyz.size() / 3);
+  }
+  TractogramHeader header;
+  header.format = "trx";
+  header.per_point.push_back({"x", 1, "float32", {}});
+  writeTractogram(dir.file("x.trx"), t, header);
+  const auto factory = [&] { return openTractogram(dir.file("x.trx")); };
+  for (const bool resample : {false, true}) {
+    CompressOptions options = quietOptions();
+    options.resample = resample;
+    options.chunk_points = 2000;  // several chunks
+    const std::string out = dir.file(resample ? "r.fbl" : "p.fbl");
+    const CompressReport report = compressTractogram(factory, out, options);
+    EXPECT_TRUE(report.dropped.empty()) << report.dropped.front();
+    const Tractogram decoded = readAllStreamlines(*openFbl(out));
+    ASSERT_EQ(decoded.per_point.size(), 1u);
+    ASSERT_EQ(decoded.per_point[0].values.size(), decoded.pointCount());
+    if (!resample) EXPECT_EQ(decoded.per_point[0].values, t.per_point[0].values);
+    else EXPECT_GT(report.resample.moved_points, 0u);
+    double worst = 0;
+    for (size_t i = 0; i < decoded.pointCount(); ++i)
+      worst = std::max(worst, std::fabs(double(decoded.per_point[0].values[i]) - double(decoded.point(i)[0])));
+    EXPECT_LE(worst, report.error.max_um * 1e-3 + 1e-5) << (resample ? "resampled" : "as given");
+  }
 }
 
 TEST(Compressor, variableStepsAreSplitOrResampledAndCounted) {

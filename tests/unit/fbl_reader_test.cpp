@@ -53,8 +53,11 @@ double arcLength(const Tractogram& t, size_t s) {
 }
 
 // What `fibscope compress` writes (see the task brief / docs/FBL_FORMAT.md).
+// With per-point arrays: their "dpv/<name>" sections and the
+// "fiber_first_point" table, whose second entry is off by
+// `first_point_shift` (a lying table, checksums intact).
 Written writeFbl(const std::string& path, const Tractogram& t, const TractogramHeader& like,
-                 uint32_t points_per_fiblet = 60) {
+                 uint32_t points_per_fiblet = 60, int64_t first_point_shift = 0) {
   CodecParamOptions options;
   options.points_per_fiblet = points_per_fiblet;
   Written w;
@@ -76,6 +79,15 @@ Written writeFbl(const std::string& path, const Tractogram& t, const TractogramH
   for (const DataArray& a : t.per_streamline)
     writer.writeSection({std::string(kFblSectionDpsPrefix) + a.name, FblDType::kFloat32, a.components}, a.values.data(),
                         a.values.size() * 4);
+  if (!t.per_point.empty()) {
+    std::vector<uint64_t> first_point(t.offsets.begin(), t.offsets.end());
+    if (first_point.size() > 1) first_point[1] = uint64_t(int64_t(first_point[1]) + first_point_shift);
+    writer.writeSection({std::string(kFblSectionFiberFirstPoint), FblDType::kUint64, 1}, first_point.data(),
+                        first_point.size() * 8);
+    for (const DataArray& a : t.per_point)
+      writer.writeSection({std::string(kFblSectionDpvPrefix) + a.name, FblDType::kFloat32, a.components},
+                          a.values.data(), a.values.size() * 4);
+  }
   const std::string source = fblSourceJson(like);
   writer.writeSection({std::string(kFblSectionSource), FblDType::kUtf8, 1}, source.data(), source.size());
   writer.finish();
@@ -96,6 +108,7 @@ Tractogram readAll(TractogramReader& reader, size_t max_points = size_t(1) << 20
   Tractogram all, chunk;
   for (const auto& a : reader.header().per_streamline)
     all.per_streamline.push_back({a.name, a.components, a.dtype, {}});
+  for (const auto& a : reader.header().per_point) all.per_point.push_back({a.name, a.components, a.dtype, {}});
   uint64_t previous_bytes = reader.bytesRead();
   size_t n = 0;
   while (reader.read(chunk, max_points)) {
@@ -486,7 +499,7 @@ TEST(DecompressCli, infoShowsCodecFactsSectionsAndTheOriginal) {
   for (const std::string& expected :
        std::vector<std::string>{"fbl container", "N = 20", "delta", "alpha", "bytes per point", "fiblets",
                                 "fiber_first_fiblet", "fiber_length_mm", "dps/weight", "source", "CRC ok",
-                                "/data/sub-01/brain.trk", "fa (float32)", std::to_string(t.pointCount()) + " points"})
+                                "/data/sub-01/brain.trk", "dpv/fa", "fiber_first_point", std::to_string(t.pointCount()) + " points"})
     EXPECT_NE(r.output.find(expected), std::string::npos) << expected << "\n" << r.output;
   EXPECT_EQ(r.output.find("BAD"), std::string::npos) << r.output;
 
@@ -507,13 +520,14 @@ TEST(DecompressCli, infoShowsCodecFactsSectionsAndTheOriginal) {
   EXPECT_EQ(f.at("file_bytes"), std::filesystem::file_size(fbl));
   EXPECT_DOUBLE_EQ(f.at("bytes_per_point").get<double>(),
                    double(std::filesystem::file_size(fbl)) / double(t.pointCount()));
-  ASSERT_EQ(f.at("sections").size(), 5u);
+  ASSERT_EQ(f.at("sections").size(), 7u);
   EXPECT_EQ(f.at("sections")[0].at("name"), "fiblets");
   EXPECT_EQ(f.at("sections")[0].at("dtype"), "uint32");
   EXPECT_EQ(f.at("sections")[3].at("name"), "dps/weight");
   for (const auto& s : f.at("sections")) EXPECT_TRUE(s.at("checksum_ok").get<bool>());
   EXPECT_EQ(f.at("source").at("format"), "trk");
-  EXPECT_EQ(f.at("source").at("dropped_per_point").at(0).at("name"), "fa");
+  EXPECT_EQ(f.at("sections")[5].at("name"), "dpv/fa");
+  EXPECT_TRUE(f.at("source").at("dropped_per_point").empty());
 }
 
 TEST(DecompressCli, infoShowsWhichSectionIsDamagedBeforeTheError) {
@@ -618,6 +632,9 @@ class FblTampered : public ::testing::Test {
  protected:
   void SetUp() override {
     t_ = test::smallTractogram(25, 21, /*with_data=*/true);
+    // The per-fiber array only: a per-point one would report a tampered
+    // point count as its own length (FblPointData covers those sections).
+    t_.per_point.clear();
     // Long enough fibers that some have several fiblets at N = 8.
     written_ = writeFbl(good_, t_, headerOf(t_, "trk"), 8);
     const FblFile f = FblFile::open(good_);
@@ -780,6 +797,44 @@ TEST_F(FblTampered, malformedSourceJsonIsNamed) {
   ASSERT_NE(at, std::string::npos) << json;
   std::memcpy(bytes_.data() + source.offset + at, after.data(), after.size());
   EXPECT_MESSAGE(errorAfterRepair(), "source", "0 components");
+}
+
+// Per-point arrays (trk scalars, TRX dpv) are kept: "dpv/<name>" sections
+// with the fibers' first points, read back value for value, written back
+// by decompress to trk and TRX, and a table of first points that does not
+// match the fiblets' counts is one line naming the section.
+TEST(FblPointData, perPointArraysComeBackAndALyingFirstPointTableIsOneLine) {
+  TempDir dir;
+  const Tractogram t = test::smallTractogram(40, 5, /*with_data=*/true);
+  const std::string fbl = dir.file("scalars.fbl");
+  writeFbl(fbl, t, headerOf(t, "trk"));
+  {
+    auto reader = openFbl(fbl);
+    ASSERT_EQ(reader->header().per_point.size(), 1u);
+    EXPECT_EQ(reader->header().per_point[0].name, "fa");
+  }
+  const Tractogram decoded = readFbl(fbl, 100);  // chunks of a few fibers: the values split with the points
+  ASSERT_EQ(decoded.per_point.size(), 1u);
+  EXPECT_EQ(decoded.per_point[0].values, t.per_point[0].values);
+  for (const std::string ext : {"trk", "trx"}) {
+    const std::string out = dir.file("back." + ext);
+    const auto r = test::runFibscope("decompress " + fbl + " " + out);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const Tractogram back = readTractogram(out);
+    ASSERT_EQ(back.per_point.size(), 1u) << ext;
+    EXPECT_EQ(back.per_point[0].name, "fa") << ext;
+    ASSERT_EQ(back.per_point[0].values.size(), t.per_point[0].values.size()) << ext;
+    for (size_t i = 0; i < back.per_point[0].values.size(); ++i)
+      ASSERT_FLOAT_EQ(back.per_point[0].values[i], t.per_point[0].values[i]) << ext << " point " << i;
+  }
+  for (const int64_t shift : {int64_t(1), int64_t(-1)}) {
+    const std::string bad = dir.file("lying" + std::to_string(shift) + ".fbl");
+    writeFbl(bad, t, headerOf(t, "trk"), 60, shift);
+    const std::string message = test::errorOf([&] { readFbl(bad); });
+    EXPECT_NE(message.find(bad), std::string::npos) << message;
+    EXPECT_NE(message.find("fiber_first_point"), std::string::npos) << message;
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  }
 }
 
 }  // namespace
