@@ -23,10 +23,12 @@ layout(push_constant, std430) uniform Push { SvoVoxelizePush pc; };
 layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer NodesRef { TubeNode nodes[]; };
 layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer SegmentsRef { TubeSegment segments[]; };
 layout(buffer_reference, std430, buffer_reference_align = 4) buffer FieldRef { uint keys[]; };
+layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer ListRef { uint ids[]; };
 
 void main() {
-  const uint seg = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
-  if (seg >= pc.segment_count) return;
+  const uint g = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
+  if (g >= pc.segment_count) return;
+  const uint seg = pc.list != 0ul ? ListRef(pc.list).ids[g] : g;
   const TubeSegment s = SegmentsRef(pc.segments).segments[seg];
   const TubeNode na = NodesRef(pc.nodes).nodes[s.node], nb = NodesRef(pc.nodes).nodes[s.node + 1u];
   const SvoCapsuleF c = svoCapsuleOf(na, nb);

@@ -97,7 +97,7 @@ SVO_CONST uint kRadixBlock = 256u;           // keys per workgroup of the histog
 SVO_CONST uint kRadixDigits = 16u;           // 4 bits per pass
 SVO_CONST uint kSvoTraceTile = 8u;           // 8 x 8 pixels per workgroup
 
-// svo_voxelize.comp: workgroup g takes segment g; its invocations walk the
+// svo_voxelize.comp: workgroup g takes segment g (or list[g]); its invocations walk the
 // voxels of the segment's box (widened by r + band) inside the slab
 // z in [slab_z0, slab_z0 + slab_depth) and atomicMin svoOrderedKey(f_s) into
 // field[((z - slab_z0) * rows + y) * side + x] where f_s < band (rows =
@@ -106,6 +106,10 @@ struct SvoVoxelizePush {
   uint64_t nodes;     // TubeNode[]
   uint64_t segments;  // TubeSegment[]
   uint64_t field;     // uint per voxel of the slab; kSvoFar before the pass
+  // uint[segment_count]: the segments to splat, workgroup g taking
+  // list[g] (the octree build's segments whose band reaches the slab); 0:
+  // workgroup g takes segment g.
+  uint64_t list;
   float origin_x, origin_y, origin_z;  // grid origin (mm)
   float voxel;                         // voxel size (mm)
   uint side;
@@ -187,8 +191,8 @@ SHADER_NAMESPACE_END
 #ifdef __cplusplus
 #include <cstddef>
 static_assert(sizeof(fibscope::shader::SvoNode) == 8, "an octree node is 8 bytes");
-static_assert(sizeof(fibscope::shader::SvoVoxelizePush) == 72, "");
-static_assert(offsetof(fibscope::shader::SvoVoxelizePush, side) == 40, "");
+static_assert(sizeof(fibscope::shader::SvoVoxelizePush) == 80, "");
+static_assert(offsetof(fibscope::shader::SvoVoxelizePush, side) == 48, "");
 static_assert(sizeof(fibscope::shader::SvoCompactPush) == 64, "");
 static_assert(sizeof(fibscope::shader::RadixPush) == 56, "");
 static_assert(sizeof(fibscope::shader::SvoTracePush) == 80, "");

@@ -120,6 +120,13 @@ void curveBounds(const SvoCurve& c, glm::vec3& lo, glm::vec3& hi) {
   hi = glm::max(glm::max(c.p0, c.p1), glm::max(b1, b2));
 }
 
+void svoSegmentBounds(const TubeModel& model, const shader::TubeSegment& s, bool curved, glm::vec3& lo, glm::vec3& hi,
+                      float& radius) {
+  const SegmentShape shape = segmentShape(model, s, curved);
+  shape.bounds(lo, hi);
+  radius = shape.radius();
+}
+
 SvoGrid chooseSvoGrid(const TubeModel& model, float voxel_mm, bool curved, uint64_t memory_limit_bytes) {
   if (!std::isfinite(voxel_mm) || voxel_mm < 0.0f)
     throw Error("svo: the voxel size must be > 0 mm (got " + std::to_string(voxel_mm) + ")");
@@ -219,6 +226,7 @@ SvoMemoryNeed estimateSvoMemory(const TubeModel& model, const SvoGrid& grid, uin
   need.sort = need.leaves * 4 * 4;
   need.nodes = need.leaves * 8 * 8 / 7 + 8;
   need.decoration = (need.leaves + references) * 4;  // a count per leaf, an index per reference
+  need.lists = uint64_t(model.segments.size()) * 2 * 4;
   return need;
 }
 

@@ -73,6 +73,11 @@ float curveDistance(const SvoCurve& c, const glm::vec3& p, float* u_out = nullpt
 // p0, p0 + m0 / 3, p1 - m1 / 3, p1 (the curve lies in their convex hull).
 void curveBounds(const SvoCurve& c, glm::vec3& lo, glm::vec3& hi);
 
+// The box of segment s's centre line as the grid takes it: the capsule's
+// two ends, or (curved) curveBounds; radius: the tube's.
+void svoSegmentBounds(const TubeModel& model, const shader::TubeSegment& s, bool curved, glm::vec3& lo, glm::vec3& hi,
+                      float& radius);
+
 // The grid for `model`: the box of every capsule widened by r + 2 band,
 // cubic, 2^levels voxels a side. `voxel_mm` > 0 is taken as given; 0
 // chooses it from the data: r_min / 2 (two voxels per radius: a tube's
@@ -114,7 +119,8 @@ struct SvoMemoryNeed {
   uint64_t sort = 0;        // leaf keys and values, twice (the sort's ping-pong)
   uint64_t nodes = 0;       // tree, about 8/7 of the leaves' blocks
   uint64_t decoration = 0;  // count + indices per leaf
-  uint64_t total() const { return field + sort + nodes + decoration; }
+  uint64_t lists = 0;       // the slabs' segment lists (a segment in two slabs, as most are at most)
+  uint64_t total() const { return field + sort + nodes + decoration + lists; }
 };
 // `slab_depth` voxels of z per slab of the dense field.
 SvoMemoryNeed estimateSvoMemory(const TubeModel& model, const SvoGrid& grid, uint32_t slab_depth);

@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <deque>
 #include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "core/error.h"
 #include "core/progress.h"
@@ -96,6 +99,44 @@ void recordRadixSort(const gpu::VulkanContext& context, VkCommandBuffer cmd, con
   }
 }
 
+// Each slab's segments, as compressed rows: slab k's are
+// ids[first[k] .. first[k + 1]), those whose box widened by r + band (and a
+// voxel more than the shader's rounding can need) reaches the slab's z
+// range. Splatting only these keeps the voxelisation's work at the
+// segments times the slabs each spans, not times all slabs, and a slab no
+// segment reaches is skipped (it can hold no leaf).
+struct SlabLists {
+  std::vector<uint64_t> first;  // slabs + 1
+  std::vector<uint32_t> ids;
+};
+SlabLists slabSegmentLists(const TubeModel& model, const SvoGrid& grid, uint32_t slab_depth, uint32_t slabs) {
+  const int side = int(grid.side());
+  std::vector<std::pair<uint32_t, uint32_t>> span(model.segments.size(), {1, 0});  // slabs [lo, hi]; empty: lo > hi
+  SlabLists out;
+  out.first.assign(size_t(slabs) + 1, 0);
+  for (size_t i = 0; i < model.segments.size(); ++i) {
+    glm::vec3 lo, hi;
+    float radius = 0.0f;
+    svoSegmentBounds(model, model.segments[i], grid.curved, lo, hi, radius);
+    const float pad = radius + grid.band() + grid.voxel;
+    const int zlo = std::max(0, int(std::floor((lo.z - pad - grid.origin.z) / grid.voxel - 0.5f)));
+    const int zhi = std::min(side - 1, int(std::ceil((hi.z + pad - grid.origin.z) / grid.voxel - 0.5f)));
+    if (zlo > zhi) continue;
+    span[i] = {uint32_t(zlo) / slab_depth, uint32_t(zhi) / slab_depth};
+    for (uint32_t k = span[i].first; k <= span[i].second; ++k) ++out.first[k + 1];
+  }
+  for (uint32_t k = 0; k < slabs; ++k) out.first[k + 1] += out.first[k];
+  out.ids.resize(out.first[slabs]);
+  std::vector<uint64_t> at(out.first.begin(), out.first.end() - 1);
+  for (size_t i = 0; i < span.size(); ++i)
+    for (uint32_t k = span[i].first; k <= span[i].second; ++k) out.ids[at[k]++] = uint32_t(i);
+  return out;
+}
+
+// Segments splatted per submission at most: one submission of a whole
+// slab's list can run past the fence timeout on a CPU device.
+constexpr uint64_t kVoxelizeBatchSegments = uint64_t(1) << 20;
+
 }  // namespace
 
 uint64_t svoMemoryLimit(const gpu::VulkanContext& context, const SvoGpuBuildOptions& options) {
@@ -141,8 +182,8 @@ void recordSvoVoxelize(const gpu::VulkanContext& context, VkCommandBuffer cmd, c
                        const GpuTubes& tubes, shader::SvoVoxelizePush push) {
   push.nodes = tubes.nodes.address;
   push.segments = tubes.segments.address;
-  push.segment_count = tubes.segment_count;
-  const gpu::DispatchGrid g = gpu::dispatchGrid(context, tubes.segment_count);
+  if (push.list == 0) push.segment_count = tubes.segment_count;
+  const gpu::DispatchGrid g = gpu::dispatchGrid(context, push.segment_count);
   gpu::recordDispatch(cmd, voxelize, push, g.x, g.y);
 }
 
@@ -187,48 +228,61 @@ std::vector<SvoLeaf> voxelizeSvoLeavesGpu(const gpu::VulkanContext& context, con
   uint64_t capacity = std::max<uint64_t>(st.need.leaves, 1024);
   uint32_t count = 0;
   auto start = std::chrono::steady_clock::now();
+  const SlabLists lists = slabSegmentLists(model, grid, slab_depth, st.slabs);
+  gpu::Buffer& list_buffer = b.make(std::max<size_t>(lists.ids.size(), 1) * 4, gpu::MemoryUse::DeviceLocal);
+  if (!lists.ids.empty()) gpu::uploadToBuffer(context, list_buffer, lists.ids.data(), lists.ids.size() * 4);
   for (;;) {
     gpu::Buffer& keys = b.make(capacity * 4, gpu::MemoryUse::DeviceLocal);
     gpu::Buffer& values = b.make(capacity * 4, gpu::MemoryUse::DeviceLocal);
     Progress progress("voxelising", double(st.slabs), "slabs", options.progress);
     const uint32_t fill_zero = 0;
     gpu::uploadToBuffer(context, count_buffer, &fill_zero, 4);
-    for (uint32_t z0 = 0; z0 < side; z0 += slab_depth) {
+    for (uint32_t slab = 0; slab < st.slabs; ++slab) {
+      const uint32_t z0 = slab * slab_depth;
       const uint32_t depth = uint32_t(std::min<uint64_t>(slab_depth, side - z0));
-      gpu::submitOnce(context, [&](VkCommandBuffer cmd) {
-        // The previous slab's reads of the field before it is refilled.
-        gpu::recordBarrier(cmd, {VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, gpu::kStorageReadWrite,
-                                 VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT});
-        vkCmdFillBuffer(cmd, field.buffer, 0, VK_WHOLE_SIZE, shader::kSvoFar);
-        gpu::recordBarrier(cmd, gpu::kTransferToCompute);
-        shader::SvoVoxelizePush vp{};
-        vp.field = field.address;
-        vp.origin_x = grid.origin.x;
-        vp.origin_y = grid.origin.y;
-        vp.origin_z = grid.origin.z;
-        vp.voxel = grid.voxel;
-        vp.side = uint32_t(side);
-        vp.slab_z0 = z0;
-        vp.slab_depth = depth;
-        vp.band = grid.band();
-        vp.curved = grid.curved ? 1u : 0u;
-        recordSvoVoxelize(context, cmd, voxelize, tubes, vp);
-        gpu::computeToComputeBarrier(cmd);
-        shader::SvoCompactPush cp{};
-        cp.field = field.address;
-        cp.keys = keys.address;
-        cp.values = values.address;
-        cp.count = count_buffer.address;
-        cp.side = uint32_t(side);
-        cp.slab_z0 = z0;
-        cp.slab_depth = depth;
-        cp.capacity = uint32_t(std::min<uint64_t>(capacity, 0xFFFFFFFFu));
-        cp.band = grid.band();
-        const uint64_t voxels = side * side * depth;
-        const gpu::DispatchGrid cg =
-            gpu::dispatchGrid(context, (voxels + shader::kSvoCompactGroupSize - 1) / shader::kSvoCompactGroupSize);
-        gpu::recordDispatch(cmd, compact, cp, cg.x, cg.y);
-      });
+      const uint64_t begin = lists.first[slab], end = lists.first[slab + 1];
+      for (uint64_t at = begin; at < end; at += kVoxelizeBatchSegments) {
+        const uint64_t batch = std::min(kVoxelizeBatchSegments, end - at);
+        gpu::submitOnce(context, [&](VkCommandBuffer cmd) {
+          if (at == begin) {
+            // The previous slab's reads of the field before it is refilled.
+            gpu::recordBarrier(cmd, {VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, gpu::kStorageReadWrite,
+                                     VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT});
+            vkCmdFillBuffer(cmd, field.buffer, 0, VK_WHOLE_SIZE, shader::kSvoFar);
+            gpu::recordBarrier(cmd, gpu::kTransferToCompute);
+          }
+          shader::SvoVoxelizePush vp{};
+          vp.list = list_buffer.address + at * 4;
+          vp.segment_count = uint32_t(batch);
+          vp.field = field.address;
+          vp.origin_x = grid.origin.x;
+          vp.origin_y = grid.origin.y;
+          vp.origin_z = grid.origin.z;
+          vp.voxel = grid.voxel;
+          vp.side = uint32_t(side);
+          vp.slab_z0 = z0;
+          vp.slab_depth = depth;
+          vp.band = grid.band();
+          vp.curved = grid.curved ? 1u : 0u;
+          recordSvoVoxelize(context, cmd, voxelize, tubes, vp);
+          if (at + batch < end) return;  // the slab's compaction after its last batch
+          gpu::computeToComputeBarrier(cmd);
+          shader::SvoCompactPush cp{};
+          cp.field = field.address;
+          cp.keys = keys.address;
+          cp.values = values.address;
+          cp.count = count_buffer.address;
+          cp.side = uint32_t(side);
+          cp.slab_z0 = z0;
+          cp.slab_depth = depth;
+          cp.capacity = uint32_t(std::min<uint64_t>(capacity, 0xFFFFFFFFu));
+          cp.band = grid.band();
+          const uint64_t voxels = side * side * depth;
+          const gpu::DispatchGrid cg =
+              gpu::dispatchGrid(context, (voxels + shader::kSvoCompactGroupSize - 1) / shader::kSvoCompactGroupSize);
+          gpu::recordDispatch(cmd, compact, cp, cg.x, cg.y);
+        });
+      }
       progress.add(1);
     }
     progress.finish();

@@ -27,9 +27,10 @@ namespace fibscope {
 void gpuRadixSort(const gpu::VulkanContext& context, std::vector<uint32_t>& keys, std::vector<uint32_t>& values,
                   uint32_t bits = 32);
 
-// svo_voxelize.comp, and its dispatch over every segment of `tubes` with
-// `push`'s field, grid, slab and band (the tube addresses and the segment
-// count filled in here): the octree's voxelisation and the distance field's
+// svo_voxelize.comp, and its dispatch over every segment of `tubes` (or,
+// where push.list is set, over the push.segment_count segments it lists)
+// with `push`'s field, grid, slab and band (the tube addresses, and without
+// a list the segment count, filled in here): the octree's voxelisation and the distance field's
 // (gpu_distance_field.h) record it alike. The field must hold kSvoFar
 // before and be visible to compute writes.
 gpu::ComputePipeline createSvoVoxelizePipeline(const gpu::VulkanContext& context);
