@@ -146,10 +146,25 @@ struct SvoCompactPush {
 
 // The LSD radix sort of (key, value) pairs, 4 bits a pass, stable:
 //   radix_histogram.comp  block b's count of each digit -> counts[digit * blocks + b]
-//   radix_scan.comp       exclusive scan of counts in that order (one invocation: blocks are few
-//                         at the sizes lavapipe sorts; a tree scan is the step up)
+//   radix_scan.comp       exclusive scan of counts in that order, in chunks of kRadixScanChunk
+//   radix_scan_add.comp   (RadixScanPush): each chunk scanned by one workgroup, the chunks'
+//                         totals scanned likewise one level up, and added back to their chunks
 //   radix_scatter.comp    each key to counts[digit * blocks + b] + its rank among the block's
 //                         earlier keys of the same digit
+SVO_CONST uint kRadixScanGroup = 256u;                      // invocations of a scan workgroup
+SVO_CONST uint kRadixScanChunk = 4u * kRadixScanGroup;      // counts one scan workgroup takes (4 each)
+// radix_scan.comp: the exclusive scan of data[chunk * kRadixScanChunk ..]
+// (count words in all) in place per chunk, each chunk's total to
+// sums[chunk]; radix_scan_add.comp: adds sums[chunk] (by then scanned) to
+// its chunk's words.
+struct RadixScanPush {
+  uint64_t data;  // uint[count]
+  uint64_t sums;  // uint[ceil(count / kRadixScanChunk)]
+  uint count;
+  uint pad0;
+  uint pad1;
+  uint pad2;
+};
 struct RadixPush {
   uint64_t keys_in;
   uint64_t values_in;
@@ -195,6 +210,7 @@ static_assert(sizeof(fibscope::shader::SvoVoxelizePush) == 80, "");
 static_assert(offsetof(fibscope::shader::SvoVoxelizePush, side) == 48, "");
 static_assert(sizeof(fibscope::shader::SvoCompactPush) == 64, "");
 static_assert(sizeof(fibscope::shader::RadixPush) == 56, "");
+static_assert(sizeof(fibscope::shader::RadixScanPush) == 32, "");
 static_assert(sizeof(fibscope::shader::SvoTracePush) == 80, "");
 static_assert(offsetof(fibscope::shader::SvoTracePush, levels) == 64, "");
 #endif

@@ -33,11 +33,12 @@ std::string megabytes(uint64_t bytes) {
 
 // The sort's three pipelines.
 struct RadixPipelines {
-  gpu::ComputePipeline histogram, scan, scatter;
+  gpu::ComputePipeline histogram, scan, scan_add, scatter;
   explicit RadixPipelines(const gpu::VulkanContext& c) : context(c) {
     try {
       histogram = gpu::createComputePipeline(c, "radix_histogram.comp", sizeof(shader::RadixPush));
-      scan = gpu::createComputePipeline(c, "radix_scan.comp", sizeof(shader::RadixPush));
+      scan = gpu::createComputePipeline(c, "radix_scan.comp", sizeof(shader::RadixScanPush));
+      scan_add = gpu::createComputePipeline(c, "radix_scan_add.comp", sizeof(shader::RadixScanPush));
       scatter = gpu::createComputePipeline(c, "radix_scatter.comp", sizeof(shader::RadixPush));
     } catch (...) {
       destroy();
@@ -47,6 +48,7 @@ struct RadixPipelines {
   ~RadixPipelines() { destroy(); }
   void destroy() {
     gpu::destroyComputePipeline(context, scatter);
+    gpu::destroyComputePipeline(context, scan_add);
     gpu::destroyComputePipeline(context, scan);
     gpu::destroyComputePipeline(context, histogram);
   }
@@ -67,9 +69,39 @@ struct Buffers {
   std::deque<gpu::Buffer> list;
 };
 
+// Words of the sort's counts buffer for `count` keys: the digit-major
+// counts, then each level's chunk totals of the scan above them.
+uint64_t radixCountsWords(uint64_t count) {
+  const uint64_t blocks = (count + shader::kRadixBlock - 1) / shader::kRadixBlock;
+  uint64_t n = blocks * shader::kRadixDigits, words = n;
+  while (n > 1) {
+    n = (n + shader::kRadixScanChunk - 1) / shader::kRadixScanChunk;
+    words += n;
+  }
+  return words + 1;
+}
+
+// The exclusive scan of the n words at `data` in place, the chunks' totals
+// at `scratch` (and the levels above after them).
+void recordScan(const gpu::VulkanContext& context, VkCommandBuffer cmd, const RadixPipelines& p, VkDeviceAddress data,
+                uint64_t n, VkDeviceAddress scratch) {
+  const uint64_t chunks = (n + shader::kRadixScanChunk - 1) / shader::kRadixScanChunk;
+  const gpu::DispatchGrid grid = gpu::dispatchGrid(context, chunks);
+  shader::RadixScanPush push{};
+  push.data = data;
+  push.sums = scratch;
+  push.count = uint32_t(n);
+  gpu::recordDispatch(cmd, p.scan, push, grid.x, grid.y);
+  gpu::computeToComputeBarrier(cmd);
+  if (chunks <= 1) return;  // one chunk: scanned whole
+  recordScan(context, cmd, p, scratch, chunks, scratch + chunks * 4);
+  gpu::recordDispatch(cmd, p.scan_add, push, grid.x, grid.y);
+  gpu::computeToComputeBarrier(cmd);
+}
+
 // Records the sort of `count` pairs in (keys, values), using (keys2,
-// values2) and `counts` as scratch; an even number of passes, so the result
-// ends in (keys, values).
+// values2) and `counts` (radixCountsWords(count) words) as scratch; an even
+// number of passes, so the result ends in (keys, values).
 void recordRadixSort(const gpu::VulkanContext& context, VkCommandBuffer cmd, const RadixPipelines& p,
                      const gpu::Buffer& keys, const gpu::Buffer& values, const gpu::Buffer& keys2,
                      const gpu::Buffer& values2, const gpu::Buffer& counts, uint32_t count, uint32_t bits) {
@@ -92,8 +124,8 @@ void recordRadixSort(const gpu::VulkanContext& context, VkCommandBuffer cmd, con
     push.blocks = blocks;
     gpu::recordDispatch(cmd, p.histogram, push, grid.x, grid.y);
     gpu::computeToComputeBarrier(cmd);
-    gpu::recordDispatch(cmd, p.scan, push, 1);
-    gpu::computeToComputeBarrier(cmd);
+    const uint64_t n = uint64_t(blocks) * shader::kRadixDigits;
+    recordScan(context, cmd, p, counts.address, n, counts.address + n * 4);
     gpu::recordDispatch(cmd, p.scatter, push, grid.x, grid.y);
     gpu::computeToComputeBarrier(cmd);
   }
@@ -154,7 +186,6 @@ void gpuRadixSort(const gpu::VulkanContext& context, std::vector<uint32_t>& keys
                                                 std::to_string(values.size()) + " values");
   if (keys.empty()) return;
   const uint32_t count = uint32_t(keys.size());
-  const uint32_t blocks = (count + shader::kRadixBlock - 1) / shader::kRadixBlock;
   const RadixPipelines p(context);
   Buffers b(context);
   const VkDeviceSize bytes = VkDeviceSize(count) * 4;
@@ -162,7 +193,7 @@ void gpuRadixSort(const gpu::VulkanContext& context, std::vector<uint32_t>& keys
   gpu::Buffer& v = b.make(bytes, gpu::MemoryUse::DeviceLocal);
   gpu::Buffer& k2 = b.make(bytes, gpu::MemoryUse::DeviceLocal);
   gpu::Buffer& v2 = b.make(bytes, gpu::MemoryUse::DeviceLocal);
-  gpu::Buffer& counts = b.make(VkDeviceSize(blocks) * shader::kRadixDigits * 4, gpu::MemoryUse::DeviceLocal);
+  gpu::Buffer& counts = b.make(VkDeviceSize(radixCountsWords(count)) * 4, gpu::MemoryUse::DeviceLocal);
   gpu::uploadToBuffer(context, k, keys.data(), bytes);
   gpu::uploadToBuffer(context, v, values.data(), bytes);
   gpu::submitOnce(context, [&](VkCommandBuffer cmd) {
@@ -295,8 +326,7 @@ std::vector<SvoLeaf> voxelizeSvoLeavesGpu(const gpu::VulkanContext& context, con
         Progress sorting("sorting", 1, "sorts", options.progress);
         gpu::Buffer& keys2 = b.make(VkDeviceSize(count) * 4, gpu::MemoryUse::DeviceLocal);
         gpu::Buffer& values2 = b.make(VkDeviceSize(count) * 4, gpu::MemoryUse::DeviceLocal);
-        const uint32_t blocks = (count + shader::kRadixBlock - 1) / shader::kRadixBlock;
-        gpu::Buffer& counts = b.make(VkDeviceSize(blocks) * shader::kRadixDigits * 4, gpu::MemoryUse::DeviceLocal);
+        gpu::Buffer& counts = b.make(VkDeviceSize(radixCountsWords(count)) * 4, gpu::MemoryUse::DeviceLocal);
         gpu::submitOnce(context, [&](VkCommandBuffer cmd) {
           gpu::computeToComputeBarrier(cmd);  // the compaction's writes (earlier submissions)
           recordRadixSort(context, cmd, *radix, keys, values, keys2, values2, counts, count, 3 * grid.levels);
