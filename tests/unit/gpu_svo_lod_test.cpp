@@ -24,6 +24,7 @@
 #include "render/gpu/frame_stages.h"
 #include "render/gpu/frame_targets.h"
 #include "shared/gbuffer.h"
+#include "shared/render_config.h"
 #include "svo/gpu/gpu_svo.h"
 #include "svo/svo_build.h"
 #include "svo/svo_reference.h"
@@ -131,12 +132,12 @@ TEST_F(GpuSvoLod, lodOffIsTheExactWalkBitForBit) {
   }
 }
 
-// Far views of the dense bundle (straight) and of the curved arcs, lod 2
+// Far views of the dense bundle (straight) and of the curved arcs, lod 3
 // px, against the brute-force reference (curved: each cubic as 32
 // capsules, as gpu_svo_test.cpp). The bound (shared/svo.h), per pixel with
 // f = the footprint of a pixel at the hit's distance t (pixel_angle * t):
-// a stopped node's edge e < lod_px f (the stop is at t0 <= t), its
-// diagonal D = sqrt(3) e. Coverage: every reference pixel covered (the
+// a stopped node's edge e < lod_px f (the stop is at t0 <= t), e a power
+// of two voxels: D = sqrt(3) e for the largest such e. Coverage: every reference pixel covered (the
 // walk still reaches the reference's surface or stops in front of it;
 // curved: but the exact curved trace's own 1 % of grazing pixels); an
 // extra pixel's ray passes through a non-empty node, whose box holds a
@@ -157,7 +158,7 @@ TEST_F(GpuSvoLod, farViewStaysWithinTheStatedBound) {
     const SvoGrid grid = chooseSvoGrid(model, 0.0f, curved);
     const Bounds bounds = tractogramBounds(t);
     const Camera camera = fitCamera(bounds, {0.3, -1.0, 0.6}, {0, 0, 1}, 128, 128, 3.0);
-    const float lod_px = 2.0f;
+    const float lod_px = 3.0f;
     SvoTree tree;
     const std::vector<LodFrame> frames = traceWithLods(context(), model, grid, camera, {0.0f, lod_px}, &tree);
     const std::vector<shader::SurfaceTexel>& exact = frames[0].surface;
@@ -169,7 +170,7 @@ TEST_F(GpuSvoLod, farViewStaysWithinTheStatedBound) {
     const uint32_t w = camera.width, h = camera.height;
     const char* what = curved ? "curved" : "straight";
 
-    // The far view does stop: a 2-voxel node is below 2 px at the scene.
+    // The far view does stop: a 2-voxel node is below 3 px at the scene.
     glm::dvec3 o0, d0;
     tubePixelRay(camera, w / 2, h / 2, o0, d0);
     const double centre_distance = glm::length(glm::dvec3(bounds.min[0] + bounds.max[0], bounds.min[1] + bounds.max[1],
@@ -207,7 +208,11 @@ TEST_F(GpuSvoLod, farViewStaysWithinTheStatedBound) {
       const double cosine = glm::dot(d, forward);
       const double t_lod = viewZ(camera, lod[i].depth) / cosine;
       const double footprint = pa * t_lod;
-      const double diagonal = std::sqrt(3.0) * lod_px * footprint;
+      // The largest node that can stop here: edges are voxel * 2^k, and
+      // below lod_px footprints.
+      double edge = grid.voxel;
+      while (2.0 * edge < lod_px * footprint) edge *= 2.0;
+      const double diagonal = std::sqrt(3.0) * edge;
       // The hit point's distance to the nearest tube surface, past D + b.
       const glm::dvec3 p = o + t_lod * d;
       double f = INFINITY;
@@ -251,10 +256,12 @@ TEST_F(GpuSvoLod, farViewStaysWithinTheStatedBound) {
     // (1e-3 mm: the walk's slack), every hit point within D + b of a tube.
     EXPECT_LE(worst_behind, 1e-3) << line;
     EXPECT_LE(worst_off_surface, 1e-3) << line;
-    // Measured figures held to stated floors: most pixels show the
-    // reference's depth within D and its fiber.
-    EXPECT_GE(double(within_diagonal), 0.9 * double(both)) << line;
-    EXPECT_GE(double(same_fiber), 0.8 * double(both)) << line;
+    // Measured figures held to stated floors (lavapipe: within D 79.6 %
+    // straight, 87.7 % curved; the same fiber 43.9 % and 62.1 %: the dense
+    // bundle packs 24 fibers closer than a diameter, so a 3 px node holds
+    // several and its one representative is the front one only in part).
+    EXPECT_GE(double(within_diagonal), 0.75 * double(both)) << line;
+    EXPECT_GE(double(same_fiber), 0.35 * double(both)) << line;
     // The stops save work (counted, not timed).
     EXPECT_LT(frames[1].visits, frames[0].visits) << line;
     EXPECT_LT(frames[1].tests, frames[0].tests) << line;
