@@ -293,6 +293,7 @@ void runBench(const BenchOptions& o) {
       out["svo"][std::string(kSvoPipelineNames[k])]["summary"] = line;
       out["svo"][std::string(kSvoPipelineNames[k])]["node_bytes"] = tree.nodeBytes();
       out["svo"][std::string(kSvoPipelineNames[k])]["decoration_bytes"] = tree.decorationBytes();
+      out["svo"][std::string(kSvoPipelineNames[k])]["lod_bytes"] = tree.lodBytes();
       out["svo"][std::string(kSvoPipelineNames[k])]["leaves"] = tree.leaves;
       out["svo"][std::string(kSvoPipelineNames[k])]["leaves_over_4"] = tree.leaves_over_4;
       out["svo"][std::string(kSvoPipelineNames[k])]["build_s"] = svo_stats.voxelize_s + svo_stats.sort_s + svo_stats.tree_s;

@@ -72,6 +72,8 @@ TEST_F(GpuCliBenchSvo, svoLodPxListRunsEachSvoVariantOncePerValue) {
   const nlohmann::json j = nlohmann::json::parse(r.output.substr(r.output.find('{')));
   ASSERT_EQ(j["results"].size(), 5u);
   EXPECT_EQ(j["results"][0]["pipeline"], "compute/none tubes compute");
+  EXPECT_GT(j["svo"]["svo-straight"]["lod_bytes"].get<uint64_t>(), 0u);
+  EXPECT_LT(j["svo"]["svo-straight"]["lod_bytes"].get<uint64_t>(), j["svo"]["svo-straight"]["node_bytes"].get<uint64_t>());
   const char* kinds[] = {"svo-straight", "svo-straight", "svo-curved", "svo-curved"};
   const double lods[] = {0, 2, 0, 2};
   for (int i = 1; i <= 4; ++i) {
