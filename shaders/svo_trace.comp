@@ -23,6 +23,19 @@
 // surfaces from below (each distance is exact), so no step crosses one;
 // surfaces of segments not in the list do not enter the leaf. Normal: the
 // distance's gradient, p - C(u*) at the nearest point u*.
+//
+// Level of detail (pc.lod_px > 0; shared/svo.h states the error): an
+// internal node below lod_px pixel footprints at the ray's current point t0
+// is not descended; its representative segment (pc.svo_lod) stands in for
+// the subtree. The hit: the ray's front hit on the representative's
+// capsule (its chord's, curved too) where that lies in the node's stretch
+// [t0, t_exit], else the ray's closest approach to its axis, clamped to
+// that stretch. Not the box's entry: a node holding one tube then shows
+// that tube's true depth and silhouette shading rather than a cube's face,
+// and the clamp keeps every hit in the box, so the bound (the box's
+// diagonal) holds whatever the representative. Normal from its axis to
+// the hit point; fiber and position along it (curved: at the curve's
+// nearest point) from it.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_buffer_reference : require
@@ -46,6 +59,8 @@ layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer Dec
 layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer NodesRef { TubeNode nodes[]; };
 layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer SegmentsRef { TubeSegment segments[]; };
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer SurfaceRef { SurfaceTexel texels[]; };
+layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer LodRef { uint segments[]; };
+layout(buffer_reference, std430, buffer_reference_align = 4) buffer StatsRef { uint counts[]; };
 
 // Where the ray leaves the box [lo, hi].
 float boxExit(vec3 lo, vec3 hi, vec3 o, vec3 inv_d) {
@@ -98,6 +113,10 @@ void main() {
   // A bound on the walk (a ray crosses at most 3 * side leaves; each walk
   // step is one restart).
   const uint max_steps = 3u * side + 64u;
+  const bool lod = pc.lod_px > 0.0;
+  const float lod_scale = pc.lod_px * pc.pixel_angle;
+  bool lod_hit = false;
+  uint visits = 0u, tests = 0u;  // pc.stats
   for (uint step = 0u; step < max_steps && t0 < t1 && best_seg == 0xFFFFFFFFu; ++step) {
     const vec3 g = (o + d * (t0 + nudge) - origin) / voxel;
     const uvec3 gi = uvec3(clamp(ivec3(floor(g)), ivec3(0), ivec3(int(side) - 1)));
@@ -110,6 +129,21 @@ void main() {
       const float t_exit = boxExit(lo, hi, o, inv_d);
       const uint ref = SvoNodesRef(pc.svo_nodes).nodes[node].ref;
       const uint type = ref & kSvoNodeTypeMask;
+      ++visits;
+      if (type == kSvoNodeInternal && lod && float(size) * voxel < lod_scale * t0) {
+        const uint seg = LodRef(pc.svo_lod).segments[((ref & kSvoNodeIndexMask) - 1u) >> 3u];
+        const TubeSegment s = SegmentsRef(pc.segments).segments[seg];
+        const TubeNode na = NodesRef(pc.nodes).nodes[s.node], nb = NodesRef(pc.nodes).nodes[s.node + 1u];
+        const SvoCapsuleF c = svoCapsuleOf(na, nb);
+        float t;
+        if (!svoIntersectCapsule(c, o, d, 0.0, t) || t > t_exit) t = svoRayClosestApproach(c, o, d);
+        best_t = clamp(t, t0, t_exit);
+        best_seg = seg;
+        lod_hit = true;
+        ++tests;
+        if (curved) svoCurveDistance(svoCurveOf(na, nb, s.chord), o + best_t * d, best_u);
+        break;
+      }
       if (type == kSvoNodeInternal) {
         const uint half_size = size >> 1u;
         const uvec3 bits = uvec3(greaterThanEqual(gi - cell, uvec3(half_size)));
@@ -140,6 +174,7 @@ void main() {
             const vec3 q = o + t * d;
             float f = 1e30, fu = 0.0;
             uint fs = 0xFFFFFFFFu;
+            tests += count;
             for (uint k = 0u; k < count; ++k) {
               const uint seg = DecorationRef(pc.decoration).words[list + 1u + k];
               const TubeSegment s = SegmentsRef(pc.segments).segments[seg];
@@ -167,6 +202,7 @@ void main() {
           break;
         }
         float leaf_best = t_exit + slack;
+        tests += count;
         for (uint k = 0u; k < count; ++k) {
           const uint seg = DecorationRef(pc.decoration).words[list + 1u + k];
           const TubeSegment s = SegmentsRef(pc.segments).segments[seg];
@@ -184,6 +220,10 @@ void main() {
       break;
     }
   }
+  if (pc.stats != 0ul) {
+    atomicAdd(StatsRef(pc.stats).counts[0], visits);
+    atomicAdd(StatsRef(pc.stats).counts[1], tests);
+  }
   if (best_seg == 0xFFFFFFFFu) return;
 
   const vec3 hit = o + best_t * d;
@@ -200,7 +240,8 @@ void main() {
     SurfaceTexel texel;
     texel.depth = depth;
     texel.fiber = s.fiber;
-    texel.normal = packSegmentTangent(hit - centre);
+    // A level-of-detail hit may lie on the centre line: facing the eye then.
+    texel.normal = packSegmentTangent(lod_hit && hit == centre ? -d : hit - centre);
     texel.tangent = dot(along, along) > 0.0 ? packSegmentTangent(along) : texel.normal;
     texel.position = mix(na.point, nb.point, best_u);
     texel.color = 0u;
@@ -216,7 +257,7 @@ void main() {
   SurfaceTexel texel;
   texel.depth = depth;
   texel.fiber = s.fiber;
-  texel.normal = packSegmentTangent(hit - (c.a + u * ba));
+  texel.normal = packSegmentTangent(lod_hit && hit == c.a + u * ba ? -d : hit - (c.a + u * ba));
   // A sphere (zero-length segment) has no direction: its normal, as the
   // spline tubes do.
   texel.tangent = baba > 0.0 ? packSegmentTangent(ba) : texel.normal;

@@ -60,4 +60,18 @@ bool svoIntersectCapsule(SvoCapsuleF c, vec3 o, vec3 d, float t_min, out float t
   return best < 1e30;
 }
 
+// t of the ray o + t d's (|d| = 1) closest approach to the segment [a, b]
+// (the level of detail's hit where the ray misses the capsule): from the
+// components perpendicular to d, so a far eye's distance cancels before
+// the division; a segment parallel to the ray (or of zero length) by its
+// middle.
+float svoRayClosestApproach(SvoCapsuleF c, vec3 o, vec3 d) {
+  const vec3 ba = c.b - c.a, w = o - c.a;
+  const float wd = dot(w, d), bd = dot(ba, d);
+  const vec3 wp = w - wd * d, bp = ba - bd * d;
+  const float bpbp = dot(bp, bp);
+  const float s = bpbp > 1e-12 * max(dot(ba, ba), 1e-30) ? clamp(dot(wp, bp) / bpbp, 0.0, 1.0) : 0.5;
+  return s * bd - wd;
+}
+
 #endif

@@ -186,6 +186,21 @@ struct RadixPush {
 // each leaf, sphere tracing of the union of the list's curved-tube
 // distances from the leaf's entry (at most kSvoSphereSteps steps), a hit
 // where it falls below kSvoHitEpsilon * voxel within the leaf's stretch.
+//
+// Level of detail (lod_px > 0; issue 16 item 3, the seed's future work):
+// an internal node whose edge is below lod_px pixel footprints at the
+// ray's current point (edge < lod_px * pixel_angle * t) is not descended:
+// it is taken as hit (it holds a leaf) by its representative segment,
+// svo_lod[block], block = (child block's node index - 1) / 8 (every
+// internal node owns exactly one child block and the blocks follow the
+// root in order, so this numbers the internal nodes densely). The hit
+// point lies in the node's stretch of the ray. The error, stated: depth
+// (along the ray) at most the node's diagonal sqrt(3) * edge before the
+// nearest true surface in that node, which is < sqrt(3) * lod_px pixel
+// footprints at that depth; coverage only grows (every pixel the exact
+// walk covers stays covered) and by at most the nodes' projection around
+// the tubes (< sqrt(3) * lod_px + 1 pixels). lod_px = 0: the exact walk,
+// bit for bit.
 struct SvoTracePush {
   uint64_t camera;      // CameraBlock
   uint64_t svo_nodes;   // SvoNode[]
@@ -199,6 +214,13 @@ struct SvoTracePush {
   uint width;
   uint height;
   uint curved;  // 1: sphere-trace the leaf's curved tubes (svo-curved), 0: exact capsules
+  float lod_px;       // 0: off
+  float pixel_angle;  // a pixel's footprint per mm along the ray (2 tan(fov_y / 2) / height)
+  uint64_t svo_lod;   // uint per internal node: its representative segment (read only when lod_px > 0)
+  // uint[2] (0: none): += the walk's node visits and the segments it
+  // tests (capsule intersections or curved-distance evaluations), for
+  // tests and benchmarks; one atomic per pixel when set.
+  uint64_t stats;
 };
 
 SHADER_NAMESPACE_END
@@ -211,7 +233,8 @@ static_assert(offsetof(fibscope::shader::SvoVoxelizePush, side) == 48, "");
 static_assert(sizeof(fibscope::shader::SvoCompactPush) == 64, "");
 static_assert(sizeof(fibscope::shader::RadixPush) == 56, "");
 static_assert(sizeof(fibscope::shader::RadixScanPush) == 32, "");
-static_assert(sizeof(fibscope::shader::SvoTracePush) == 80, "");
+static_assert(sizeof(fibscope::shader::SvoTracePush) == 104, "");
+static_assert(offsetof(fibscope::shader::SvoTracePush, svo_lod) == 88, "");
 static_assert(offsetof(fibscope::shader::SvoTracePush, levels) == 64, "");
 #endif
 

@@ -52,6 +52,9 @@ struct BenchOptions {
   // ray-traced from the octree over the compute pipeline's lines; --voxel
   // as render's.
   float voxel_mm = 0.0f;
+  // --svo-lod-px PX[,PX...]: the SVO trace's level of detail, each svo
+  // variant once per value (empty: 0, off).
+  std::string svo_lod_px;
   uint32_t frames = 316;
   double step_deg = 1.14;
   double elevation_deg = 0;
@@ -92,6 +95,7 @@ struct Variant {
   std::string label;  // "compute/two-phase"
   bool tubes = false;  // draws the tubes (--tubes; "none" in --tube-compare: not)
   int svo = -1;        // the octree it traces: 0 straight, 1 curved; -1 none
+  float svo_lod_px = 0;  // its trace's level of detail (0: off)
   RenderSettings settings;
   std::vector<double> gpu_ms, wall_ms, drawn_fraction, lod_fraction, tube_ms;
   uint64_t tube_method_bytes = 0;  // the largest seen
@@ -146,6 +150,7 @@ std::vector<Variant> variantsFrom(BenchOptions o) {
                                                                        : commaSeparated(o.tube_compare);
   if (!tube_methods.empty() && !o.tubes.requested())
     throw Error("--tube-compare: give the tubes to draw (--tubes FIBERS|all|filtered)");
+  const std::vector<float> lods = o.svo_lod_px.empty() ? std::vector<float>{0.0f} : parseSvoLodPx(o.svo_lod_px);
   std::vector<Variant> variants;
   for (const std::string& spec : specs) {
     Variant v;
@@ -157,7 +162,16 @@ std::vector<Variant> variantsFrom(BenchOptions o) {
       v.settings.pipeline = RenderPipeline::Compute;
       if (slash != std::string::npos) v.settings.culling = parseCullingMode(spec.substr(slash + 1));
       v.label = spec.substr(0, slash) + "/" + std::string(cullingModeName(v.settings.culling));
-      variants.push_back(std::move(v));
+      for (const float lod : lods) {
+        Variant l = v;
+        l.svo_lod_px = lod;
+        if (!o.svo_lod_px.empty()) {
+          char text[32];
+          std::snprintf(text, sizeof(text), " lod %g px", double(lod));
+          l.label += text;
+        }
+        variants.push_back(std::move(l));
+      }
       continue;
     }
     v.settings.pipeline = parseRenderPipeline(spec.substr(0, slash));
@@ -233,6 +247,8 @@ void runBench(const BenchOptions& o) {
   if (svo_used[0] || svo_used[1]) useSvoTubeDefaults(tube_options);
   if (o.voxel_mm != 0.0f && !(svo_used[0] || svo_used[1]))
     throw Error("--voxel: only with an svo-straight or svo-curved pipeline");
+  if (!o.svo_lod_px.empty() && !(svo_used[0] || svo_used[1]))
+    throw Error("--svo-lod-px: only with an svo-straight or svo-curved pipeline");
   if (!(o.voxel_mm >= 0.0f) || !std::isfinite(o.voxel_mm))
     throw Error("--voxel: expected a voxel size > 0 mm, got " + std::to_string(o.voxel_mm));
   SceneOptions scene_options;
@@ -269,14 +285,15 @@ void runBench(const BenchOptions& o) {
       SvoGpuBuildOptions build;
       build.progress = true;
       SvoGpuBuildStats svo_stats;
-      const SvoTree tree = buildSvoGpu(*context, model, tubes, chooseSvoGrid(model, o.voxel_mm, k == 1, svoMemoryLimit(*context, build)), build,
-                                       &svo_stats);
+      const SvoGrid grid = chooseSvoGrid(model, o.voxel_mm, k == 1, svoMemoryLimit(*context, build));
+      const SvoTree tree = buildSvoGpu(*context, model, tubes, grid, build, &svo_stats);
       svos[k] = uploadSvo(*context, tree);
       const std::string line = svoBuildSummary(model, tree, svo_stats);
       if (!o.json) std::printf("%s: %s\n", std::string(kSvoPipelineNames[k]).c_str(), line.c_str());
       out["svo"][std::string(kSvoPipelineNames[k])]["summary"] = line;
       out["svo"][std::string(kSvoPipelineNames[k])]["node_bytes"] = tree.nodeBytes();
       out["svo"][std::string(kSvoPipelineNames[k])]["decoration_bytes"] = tree.decorationBytes();
+      out["svo"][std::string(kSvoPipelineNames[k])]["lod_bytes"] = tree.lodBytes();
       out["svo"][std::string(kSvoPipelineNames[k])]["leaves"] = tree.leaves;
       out["svo"][std::string(kSvoPipelineNames[k])]["leaves_over_4"] = tree.leaves_over_4;
       out["svo"][std::string(kSvoPipelineNames[k])]["build_s"] = svo_stats.voxelize_s + svo_stats.sort_s + svo_stats.tree_s;
@@ -296,7 +313,8 @@ void runBench(const BenchOptions& o) {
   for (size_t i = 0; i < variants.size(); ++i)
     renderers.push_back(std::make_unique<FrameRenderer>(
         *context, width, height,
-        variants[i].svo >= 0 ? withSvoStage(standardFrameStages(), &svos[variants[i].svo], &tubes)
+        variants[i].svo >= 0 ? withSvoStage(standardFrameStages(), &svos[variants[i].svo], &tubes,
+                                            SvoTraceOptions{variants[i].svo_lod_px})
         : variants[i].tubes  ? withTubeStage(standardFrameStages(), &tubes)
                              : standardFrameStages()));
   // --count-missed: the unculled frame each culled compute variant is
@@ -449,6 +467,7 @@ void runBench(const BenchOptions& o) {
     j["segments_drawn_per_ms"] = segments_per_ms;
     if (!v.tube_ms.empty()) {
       j["tube_method"] = v.svo >= 0 ? kSvoPipelineNames[v.svo] : tubeMethodName(v.settings.tube_method);
+      if (v.svo >= 0) j["svo_lod_px"] = v.svo_lod_px;
       j["tube_mean_ms"] = mean(v.tube_ms);
       j["tube_median_ms"] = percentile(v.tube_ms, 50);
       j["tube_method_bytes"] = v.tube_method_bytes;
@@ -517,6 +536,9 @@ void addBenchCommand(CLI::App& app) {
   cmd->add_option("--voxel", o->voxel_mm,
                   "Voxel size of the octree in mm for svo-straight and svo-curved (--pipeline or --compare; default: "
                   "from the tube radius and the step, coarser where the octree would not fit the device's memory)");
+  cmd->add_option("--svo-lod-px", o->svo_lod_px,
+                  std::string(kSvoLodHelp) + "; PX,PX,...: each svo variant once per value, on the same frames "
+                  "[default 0]");
   cmd->add_option("--frames", o->frames, "Measured frames")->capture_default_str();
   cmd->add_option("--step", o->step_deg, "Orbit step per frame, degrees")->capture_default_str();
   cmd->add_option("--elevation", o->elevation_deg, "Orbit elevation, degrees")->capture_default_str();

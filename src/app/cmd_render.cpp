@@ -39,6 +39,7 @@ struct RenderCommandOptions {
   std::string output;
   float voxel_mm = 0.0f;  // --voxel (svo-straight, svo-curved); 0: chosen from the data
   bool voxel_given = false;
+  std::string svo_lod_px;  // --svo-lod-px (svo-straight, svo-curved); empty: 0, off
 };
 
 // `--pipeline svo-straight` (issue 16): the fibers of --tubes (all by
@@ -91,6 +92,10 @@ void runRender(RenderCommandOptions o) {
   if (o.voxel_given && !svo) throw Error("--voxel: only with --pipeline svo-straight or svo-curved");
   if (o.voxel_given && !(o.voxel_mm > 0.0f && std::isfinite(o.voxel_mm)))
     throw Error("--voxel: expected a voxel size > 0 mm, got " + std::to_string(o.voxel_mm));
+  if (!o.svo_lod_px.empty() && !svo) throw Error("--svo-lod-px: only with --pipeline svo-straight or svo-curved");
+  const std::vector<float> lods = o.svo_lod_px.empty() ? std::vector<float>{0.0f} : parseSvoLodPx(o.svo_lod_px);
+  if (lods.size() != 1) throw Error("--svo-lod-px: render takes one value, got '" + o.svo_lod_px + "'");
+  const SvoTraceOptions trace_options{lods[0]};
   RenderSettings settings = renderSettingsFrom(o.render);
   const FilterCriteria criteria = criteriaFrom(o.render.criteria).criteria;  // bad specs before any work
   uint32_t width = 0, height = 0;
@@ -115,11 +120,11 @@ void runRender(RenderCommandOptions o) {
     std::unique_ptr<FrameRenderer> renderer;  // destroyed before the context
   };
   std::future<Device> making = std::async(std::launch::async, [&o, &settings, &tubes, &svo_tree, &distance_field,
-                                                               svo, wants_field, width, height] {
+                                                               svo, wants_field, width, height, trace_options] {
     Device d;
     d.context = createRenderContext(o.render);
     FrameStageList stages =
-        svo ? withSvoStage(standardFrameStages(), &svo_tree, &tubes)
+        svo ? withSvoStage(standardFrameStages(), &svo_tree, &tubes, trace_options)
             : (o.tubes.requested() ? withTubeStage(standardFrameStages(), &tubes) : standardFrameStages());
     if (wants_field) stages = withDistanceFieldStage(std::move(stages), &distance_field);
     d.renderer = std::make_unique<FrameRenderer>(*d.context, width, height, std::move(stages));
@@ -216,7 +221,10 @@ void runRender(RenderCommandOptions o) {
     double trace_ms = 0;
     for (const PassTiming& p : stats.passes)
       if (p.name == "svo trace") trace_ms += p.ms;
-    std::printf("%s; trace %.1f ms\n", svo_line.c_str(), trace_ms);
+    if (trace_options.lod_px > 0.0f)
+      std::printf("%s; trace %.1f ms (lod %g px)\n", svo_line.c_str(), trace_ms, double(trace_options.lod_px));
+    else
+      std::printf("%s; trace %.1f ms\n", svo_line.c_str(), trace_ms);
   } else if (o.tubes.requested()) {
     double tube_ms = 0;
     for (const PassTiming& p : stats.passes)
@@ -275,6 +283,7 @@ void addRenderCommand(CLI::App& app) {
                   "Voxel size of the octree in mm, with --pipeline svo-straight or svo-curved (default: from the tube radius "
                   "and the step, coarser where the octree would not fit the device's memory)")
       ->each([o](const std::string&) { o->voxel_given = true; });
+  cmd->add_option("--svo-lod-px", o->svo_lod_px, std::string(kSvoLodHelp) + " [default 0]");
   cmd->add_option("--view", o->view, "sagittal | coronal | axial");
   cmd->add_option("--camera", o->camera, "AZ,EL,DIST: orbit angles in degrees and distance factor (0: framed snugly, 1: the bounding sphere fits)");
   cmd->add_option("-o,--output", o->output, "Output PNG")->required();

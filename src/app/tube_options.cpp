@@ -144,6 +144,16 @@ void useSvoTubeDefaults(TubeCliOptions& o) {
   if (o.resample_tolerance_mm < 0.0f) o.resample_tolerance_mm = 0.0f;
 }
 
+std::vector<float> parseSvoLodPx(const std::string& text) {
+  std::vector<double> values;
+  const bool ok = parseNumberList(text, values) &&
+                  std::all_of(values.begin(), values.end(), [](double v) { return v >= 0.0 && v <= kSvoLodMaxPx; });
+  if (!ok)
+    throw Error("--svo-lod-px: expected pixels from 0 (off) to " + std::to_string(int(kSvoLodMaxPx)) +
+                " (a comma list in bench), got '" + text + "'");
+  return std::vector<float>(values.begin(), values.end());
+}
+
 std::vector<uint32_t> parseFiberSelection(const std::string& text, uint64_t count) {
   std::vector<uint32_t> out;
   if (text == "all") {

@@ -48,6 +48,17 @@ int svoPipelineKind(std::string_view pipeline);
 // every point too, so straight and curved tubes share their nodes).
 void useSvoTubeDefaults(TubeCliOptions& options);
 
+// --svo-lod-px (render: one value; bench: a comma list, each svo variant
+// once per value, side by side): the SVO trace's level of detail
+// (SvoTraceOptions::lod_px), pixels in [0, kSvoLodMaxPx], 0 off. Throws
+// Error (one line, naming --svo-lod-px) for anything else, an empty list
+// included. Safe on untrusted text.
+inline constexpr float kSvoLodMaxPx = 64.0f;
+inline constexpr std::string_view kSvoLodHelp =
+    "Level of detail of the svo pipelines: an octree node smaller than PX pixels stops the ray there, hit by the "
+    "node's most referenced segment (depth within the node's diagonal); 0: off";
+std::vector<float> parseSvoLodPx(const std::string& text);
+
 // "all" -> every index below `count`; "A-B,C,..." -> those indices, in the
 // order given, repeats dropped. Throws Error (one line, naming --tubes) for
 // malformed text, a reversed range or an index >= count. Safe on untrusted

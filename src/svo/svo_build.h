@@ -139,8 +139,16 @@ struct SvoTree {
   size_t leaves_over_4 = 0;          // leaves whose list holds more than 4 segments (the seed's limit)
   size_t max_segments_per_leaf = 0;
   size_t references = 0;             // segment indices in all lists
+  // Level of detail (shared/svo.h SvoTracePush::lod_px): per internal node,
+  // numbered by its child block ((child index - 1) / 8), the segment that
+  // stands in for its subtree: the one with the most references in the
+  // subtree's lists (the most surface inside the node, so the likeliest to
+  // show in a pixel the node covers; ties: the smaller index). Memory beyond
+  // the seed's table 1 (nodes + decoration): 4 bytes per internal node.
+  std::vector<uint32_t> lod;
   size_t nodeBytes() const { return nodes.size() * sizeof(nodes[0]); }
   size_t decorationBytes() const { return decoration.size() * sizeof(uint32_t); }
+  size_t lodBytes() const { return lod.size() * sizeof(uint32_t); }
 };
 
 // CPU reference of the voxelisation: the leaves (|f| < band) in Morton
@@ -154,8 +162,8 @@ std::vector<SvoLeaf> voxelizeSvoLeaves(const TubeModel& model, const SvoGrid& gr
 // segment s is in the list of a leaf where |f_s(centre)| < band. Internal
 // nodes from the leaves' codes level by level upward (code >> 3 is the
 // parent's), laid out top-down: root, then the level-1 block, then each
-// level's blocks in code order. Throws Error when the decoration exceeds
-// 2^30 words.
+// level's blocks in code order; `lod` from the same lists. Throws Error
+// when the decoration exceeds 2^30 words.
 SvoTree buildSvoTree(const TubeModel& model, const SvoGrid& grid, const std::vector<SvoLeaf>& leaves);
 
 // voxelizeSvoLeaves then buildSvoTree.

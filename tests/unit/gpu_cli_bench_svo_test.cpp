@@ -60,5 +60,39 @@ TEST_F(GpuCliBenchSvo, svoPipelinesTraceTheirOctreesOnTheSameFrames) {
   EXPECT_NE(bad.output.find("--voxel"), std::string::npos) << bad.output;
 }
 
+// --svo-lod-px PX,PX: each svo variant once per value on the same frames,
+// labelled, the value in the JSON; the LoD frame traces fewer segments'
+// worth of time is not asserted (benchmarks measure it). Without an svo
+// pipeline or with a bad value: one line, exit code 2.
+TEST_F(GpuCliBenchSvo, svoLodPxListRunsEachSvoVariantOncePerValue) {
+  const auto r = test::runFibscope(
+      "bench --validate --phantom-streamlines 30 --size 64x48 --frames 2 --warmup 0 --tubes 0-3 --tube-radius 1 "
+      "--voxel 1 --compare compute/none,svo-straight,svo-curved --svo-lod-px 0,2 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json j = nlohmann::json::parse(r.output.substr(r.output.find('{')));
+  ASSERT_EQ(j["results"].size(), 5u);
+  EXPECT_EQ(j["results"][0]["pipeline"], "compute/none tubes compute");
+  EXPECT_GT(j["svo"]["svo-straight"]["lod_bytes"].get<uint64_t>(), 0u);
+  EXPECT_LT(j["svo"]["svo-straight"]["lod_bytes"].get<uint64_t>(), j["svo"]["svo-straight"]["node_bytes"].get<uint64_t>());
+  const char* kinds[] = {"svo-straight", "svo-straight", "svo-curved", "svo-curved"};
+  const double lods[] = {0, 2, 0, 2};
+  for (int i = 1; i <= 4; ++i) {
+    EXPECT_EQ(j["results"][i]["tube_method"], kinds[i - 1]) << j["results"][i].dump();
+    EXPECT_EQ(j["results"][i]["svo_lod_px"].get<double>(), lods[i - 1]) << j["results"][i].dump();
+    EXPECT_NE(j["results"][i]["pipeline"].get<std::string>().find(lods[i - 1] > 0 ? "lod 2 px" : "lod 0 px"),
+              std::string::npos)
+        << j["results"][i].dump();
+    EXPECT_TRUE(j["results"][i]["pass_mean_ms"].contains("svo trace")) << j["results"][i].dump();
+  }
+  for (const std::string& bad : {std::string(" --compare compute/none --svo-lod-px 2"),
+                                 std::string(" --pipeline svo-straight --svo-lod-px 0,-1"),
+                                 std::string(" --pipeline svo-straight --svo-lod-px 2,,3")}) {
+    const auto b = test::runFibscope("bench --phantom-streamlines 20 --size 32x24 --frames 1 --tube-radius 1" + bad);
+    EXPECT_EQ(b.exit_code, 2) << bad << ": " << b.output;
+    EXPECT_NE(b.output.find("fibscope: error: --svo-lod-px"), std::string::npos) << bad << ": " << b.output;
+    EXPECT_EQ(b.output.find('\n'), b.output.size() - 1) << bad << ": " << b.output;
+  }
+}
+
 }  // namespace
 }  // namespace fibscope

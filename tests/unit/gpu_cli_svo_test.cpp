@@ -112,5 +112,27 @@ TEST_F(GpuCliSvo, badRadiusOrVoxelIsOneLineAndExitCode2) {
   }
 }
 
+// --svo-lod-px: one value in [0, 64], only with an svo pipeline; anything
+// else is one line naming the option and exit code 2. A valid one renders
+// and the summary says the LoD.
+TEST_F(GpuCliSvo, svoLodPxRendersAndBadValuesAreOneLineAndExitCode2) {
+  const std::string common = "render --phantom-streamlines 10 --size 32x32 --tube-radius 1 -o " + dir_.file("x.png");
+  const auto ok = runFibscope(common + " --pipeline svo-straight --svo-lod-px 2");
+  ASSERT_EQ(ok.exit_code, 0) << ok.output;
+  EXPECT_NE(ok.output.find("(lod 2 px)"), std::string::npos) << ok.output;
+  EXPECT_NE(ok.output.find(", lod "), std::string::npos) << ok.output;  // its bytes in the summary
+  for (const std::string& bad : {std::string(" --pipeline svo-straight --svo-lod-px -1"),
+                                 std::string(" --pipeline svo-curved --svo-lod-px 65"),
+                                 std::string(" --pipeline svo-straight --svo-lod-px abc"),
+                                 std::string(" --pipeline svo-straight --svo-lod-px 1,2"),
+                                 std::string(" --pipeline svo-straight --svo-lod-px nan"),
+                                 std::string(" --svo-lod-px 2")}) {
+    const auto r = runFibscope(common + bad);
+    EXPECT_EQ(r.exit_code, 2) << bad << ": " << r.output;
+    EXPECT_NE(r.output.find("fibscope: error: --svo-lod-px"), std::string::npos) << bad << ": " << r.output;
+    EXPECT_EQ(r.output.find('\n'), r.output.size() - 1) << bad << ": " << r.output;
+  }
+}
+
 }  // namespace
 }  // namespace fibscope

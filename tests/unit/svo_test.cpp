@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 #include <random>
 #include <set>
 
@@ -139,6 +140,56 @@ TEST(SvoTreeBuild, everyLeafIsReachableWithItsDistanceAndEverySegmentThatTouches
   }
 }
 
+// Every reference in the lists of the leaves below `node`, counted by segment.
+void countReferences(const SvoTree& tree, uint32_t node, std::map<uint32_t, size_t>& counts) {
+  const uint32_t ref = tree.nodes[node].ref, type = ref & shader::kSvoNodeTypeMask;
+  const uint32_t index = ref & shader::kSvoNodeIndexMask;
+  if (type == shader::kSvoNodeLeaf) {
+    for (uint32_t k = 0; k < tree.decoration[index]; ++k) ++counts[tree.decoration[index + 1 + k]];
+  } else if (type == shader::kSvoNodeInternal) {
+    for (uint32_t c = 0; c < 8; ++c) countReferences(tree, index + c, counts);
+  }
+}
+
+// The level of detail's representatives (SvoTree::lod), against a count by
+// descent: each internal node's is the most referenced segment below it,
+// the smaller index on a tie; one word per internal node, at its child
+// block's number.
+TEST(SvoTreeBuild, lodRepresentativeIsTheMostReferencedSegmentBelowEachInternalNode) {
+  for (const bool curved : {false, true}) {
+    const TubeModel model = buildTubes(curved ? test::curvedSvoBundle() : test::denseSvoBundle(),
+                                       test::svoTubeOptions(0.3f));
+    const SvoTree tree = buildSvoCpu(model, chooseSvoGrid(model, 0.0f, curved));
+    size_t internal = 0, ties = 0;
+    std::set<uint32_t> representatives;
+    for (uint32_t node = 0; node < tree.nodes.size(); ++node) {
+      const uint32_t ref = tree.nodes[node].ref;
+      if ((ref & shader::kSvoNodeTypeMask) != shader::kSvoNodeInternal) continue;
+      ++internal;
+      const uint32_t block = ((ref & shader::kSvoNodeIndexMask) - 1) / 8;
+      ASSERT_LT(block, tree.lod.size());
+      std::map<uint32_t, size_t> counts;
+      countReferences(tree, node, counts);
+      ASSERT_FALSE(counts.empty()) << node;
+      uint32_t want = 0;
+      size_t most = 0;
+      for (const auto& [segment, n] : counts)  // ascending segments: the first of the largest count
+        if (n > most) {
+          most = n;
+          want = segment;
+        }
+      for (const auto& [segment, n] : counts) ties += n == most && segment != want;
+      EXPECT_EQ(tree.lod[block], want) << "node " << node;
+      representatives.insert(tree.lod[block]);
+    }
+    EXPECT_EQ(tree.lod.size(), internal);
+    EXPECT_EQ(tree.lodBytes(), 4 * internal);
+    EXPECT_GT(internal, 50u);
+    EXPECT_GT(ties, 0u);  // the tie rule was exercised
+    EXPECT_GT(representatives.size(), 10u);
+  }
+}
+
 TEST(SvoTreeBuild, noTubesGiveAnEmptyRoot) {
   TubeModel model;
   SvoGrid grid;
@@ -146,6 +197,7 @@ TEST(SvoTreeBuild, noTubesGiveAnEmptyRoot) {
   const SvoTree tree = buildSvoTree(model, grid, {});
   ASSERT_EQ(tree.nodes.size(), 1u);
   EXPECT_EQ(tree.nodes[0].ref, shader::kSvoNodeEmpty);
+  EXPECT_TRUE(tree.lod.empty());
 }
 
 TEST(SvoCapsule, intersectionMatchesSpheresAndCylinder) {

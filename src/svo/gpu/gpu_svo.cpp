@@ -367,12 +367,12 @@ std::string svoBuildSummary(const TubeModel& model, const SvoTree& tree, const S
   char text[512];
   std::snprintf(text, sizeof(text),
                 "svo: %zu segments (streamline buffer %.3f MB), voxel %.3f mm, %u^3 grid in %u slabs, %zu leaves (%zu "
-                "with more than 4 segments, at most %zu), nodes %.3f MB, decoration %.3f MB; voxelise %.3f s, sort "
-                "%.3f s, build %.3f s",
+                "with more than 4 segments, at most %zu), nodes %.3f MB, decoration %.3f MB, lod %.3f MB; voxelise "
+                "%.3f s, sort %.3f s, build %.3f s",
                 model.segments.size(), double(model.deviceBytes()) / 1e6, tree.grid.voxel, tree.grid.side(),
                 stats.slabs, tree.leaves, tree.leaves_over_4, tree.max_segments_per_leaf,
-                double(tree.nodeBytes()) / 1e6, double(tree.decorationBytes()) / 1e6, stats.voxelize_s, stats.sort_s,
-                stats.tree_s);
+                double(tree.nodeBytes()) / 1e6, double(tree.decorationBytes()) / 1e6, double(tree.lodBytes()) / 1e6,
+                stats.voxelize_s, stats.sort_s, stats.tree_s);
   return text;
 }
 
@@ -383,8 +383,10 @@ GpuSvo uploadSvo(const gpu::VulkanContext& context, const SvoTree& tree) {
     const size_t nb = std::max<size_t>(tree.nodeBytes(), 8), db = std::max<size_t>(tree.decorationBytes(), 4);
     svo.nodes = gpu::createBuffer(context, nb, gpu::MemoryUse::DeviceLocal);
     svo.decoration = gpu::createBuffer(context, db, gpu::MemoryUse::DeviceLocal);
+    svo.lod = gpu::createBuffer(context, std::max<size_t>(tree.lodBytes(), 4), gpu::MemoryUse::DeviceLocal);
     gpu::uploadToBuffer(context, svo.nodes, tree.nodes.data(), tree.nodeBytes());
     if (!tree.decoration.empty()) gpu::uploadToBuffer(context, svo.decoration, tree.decoration.data(), tree.decorationBytes());
+    if (!tree.lod.empty()) gpu::uploadToBuffer(context, svo.lod, tree.lod.data(), tree.lodBytes());
   } catch (...) {
     destroySvo(context, svo);
     throw;
@@ -393,18 +395,20 @@ GpuSvo uploadSvo(const gpu::VulkanContext& context, const SvoTree& tree) {
 }
 
 void destroySvo(const gpu::VulkanContext& context, GpuSvo& svo) {
+  gpu::destroyBuffer(context, svo.lod);
   gpu::destroyBuffer(context, svo.decoration);
   gpu::destroyBuffer(context, svo.nodes);
 }
 
-FrameStageList withSvoStage(FrameStageList stages, const GpuSvo* svo, const GpuTubes* tubes) {
+FrameStageList withSvoStage(FrameStageList stages, const GpuSvo* svo, const GpuTubes* tubes,
+                            SvoTraceOptions options) {
   using Factory = std::unique_ptr<FrameStage> (*)(const gpu::VulkanContext&);
   auto at = stages.begin();
   for (; at != stages.end(); ++at) {
     const Factory* f = at->target<Factory>();
     if (f && *f == &makeSurfaceMergeStage) break;
   }
-  stages.insert(at, svoTraceStage(svo, tubes));
+  stages.insert(at, svoTraceStage(svo, tubes, options));
   return stages;
 }
 

@@ -70,22 +70,37 @@ SvoTree buildSvoGpu(const gpu::VulkanContext& context, const TubeModel& model, c
                     const SvoGrid& grid, const SvoGpuBuildOptions& options = {}, SvoGpuBuildStats* stats = nullptr);
 
 // One line for the command line: segments, streamline buffer, grid,
-// leaves (and those over 4 segments), nodes and decoration MB, the times.
+// leaves (and those over 4 segments), nodes and decoration MB, the level
+// of detail's representatives' MB (beyond the seed's table 1), the times.
 std::string svoBuildSummary(const TubeModel& model, const SvoTree& tree, const SvoGpuBuildStats& stats);
 
 struct GpuSvo {
   gpu::Buffer nodes;       // SvoNode[]
   gpu::Buffer decoration;  // uint[]
+  gpu::Buffer lod;         // uint per internal node (SvoTree::lod)
   SvoGrid grid;
 };
 GpuSvo uploadSvo(const gpu::VulkanContext& context, const SvoTree& tree);
 void destroySvo(const gpu::VulkanContext& context, GpuSvo& svo);
 
+// The trace's own options, beside the octree's (its grid, straight or
+// curved).
+struct SvoTraceOptions {
+  // Level of detail (shared/svo.h SvoTracePush::lod_px, the error bound
+  // there): an internal node smaller than this many pixels is taken as hit
+  // by its representative segment. 0: off (the exact walk, bit for bit).
+  float lod_px = 0.0f;
+  // Not null: uint[2] (device address of a buffer the caller zeroes) that
+  // each frame adds the walk's node visits and segment tests to.
+  VkDeviceAddress stats = 0;
+};
+
 // Surfaces: "svo trace", the octree's straight tubes into the surface
 // target (svo_trace.comp). `svo` and `tubes` (the segments the tree's lists
 // index) are read every frame and must outlive the renderer.
-FrameStageFactory svoTraceStage(const GpuSvo* svo, const GpuTubes* tubes);
+FrameStageFactory svoTraceStage(const GpuSvo* svo, const GpuTubes* tubes, SvoTraceOptions options = {});
 // `stages` with the SVO stage inserted before the surface merge.
-FrameStageList withSvoStage(FrameStageList stages, const GpuSvo* svo, const GpuTubes* tubes);
+FrameStageList withSvoStage(FrameStageList stages, const GpuSvo* svo, const GpuTubes* tubes,
+                            SvoTraceOptions options = {});
 
 }  // namespace fibscope

@@ -1,6 +1,8 @@
 // Surfaces: the SVO's straight streamtubes ray-traced (or its curved ones
 // sphere-traced) by compute
 // (svo_trace.comp), into the surface target like every surface pass.
+#include <cmath>
+
 #include "gpu/compute_pipeline.h"
 #include "gpu/pass_scope.h"
 #include "shared/svo.h"
@@ -11,7 +13,8 @@ namespace {
 
 class SvoTraceStage final : public FrameStage {
  public:
-  SvoTraceStage(const GpuSvo* svo, const GpuTubes* tubes) : svo_(svo), tubes_(tubes) {}
+  SvoTraceStage(const GpuSvo* svo, const GpuTubes* tubes, SvoTraceOptions options)
+      : svo_(svo), tubes_(tubes), options_(options) {}
   void destroy(const gpu::VulkanContext& context) override { gpu::destroyComputePipeline(context, trace_); }
   uint32_t maxPasses() const override { return 1; }
   bool runs(const FrameContext&) const override {
@@ -40,6 +43,13 @@ class SvoTraceStage final : public FrameStage {
     push.width = width;
     push.height = height;
     push.curved = svo_->grid.curved ? 1u : 0u;
+    push.lod_px = options_.lod_px;
+    // The footprint of a pixel at unit distance on the view axis (slightly
+    // smaller than off axis: a node there is stopped a little later, never
+    // earlier).
+    push.pixel_angle = float(2.0 * std::tan(0.5 * frame.camera.fov_y_deg * M_PI / 180.0) / double(height));
+    push.svo_lod = svo_->lod.address;
+    push.stats = options_.stats;
     gpu::recordDispatch(frame.cmd, trace_, push, (width + shader::kSvoTraceTile - 1) / shader::kSvoTraceTile,
                         (height + shader::kSvoTraceTile - 1) / shader::kSvoTraceTile);
   }
@@ -47,13 +57,16 @@ class SvoTraceStage final : public FrameStage {
  private:
   const GpuSvo* svo_;
   const GpuTubes* tubes_;
+  SvoTraceOptions options_;
   gpu::ComputePipeline trace_;  // made at the first frame
 };
 
 }  // namespace
 
-FrameStageFactory svoTraceStage(const GpuSvo* svo, const GpuTubes* tubes) {
-  return [svo, tubes](const gpu::VulkanContext&) { return std::make_unique<SvoTraceStage>(svo, tubes); };
+FrameStageFactory svoTraceStage(const GpuSvo* svo, const GpuTubes* tubes, SvoTraceOptions options) {
+  return [svo, tubes, options](const gpu::VulkanContext&) {
+    return std::make_unique<SvoTraceStage>(svo, tubes, options);
+  };
 }
 
 }  // namespace fibscope
