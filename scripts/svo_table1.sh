@@ -82,8 +82,8 @@ for name in seed:
     text = log.read_text()
     ph = re.search(r"(\d+) streamlines, (\d+) points", (out / f"{name}.phantom.log").read_text())
     m = re.search(r"streamline buffer ([\d.]+) MB\), voxel ([\d.]+) mm, (\d+)\^3 grid.*?, (\d+) leaves \((\d+) with "
-                  r"more than 4.*?nodes ([\d.]+) MB, decoration ([\d.]+) MB; voxelise ([\d.]+) s, sort ([\d.]+) s, "
-                  r"build ([\d.]+) s", text)
+                  r"more than 4.*?nodes ([\d.]+) MB, decoration ([\d.]+) MB(?:, lod [\d.]+ MB)?; voxelise ([\d.]+) s, "
+                  r"sort ([\d.]+) s, build ([\d.]+) s", text)
     wall = re.search(r"wall ([\d.]+) s", text)
     if not m:
         err = next((l for l in text.splitlines() if "error" in l), "no summary")
