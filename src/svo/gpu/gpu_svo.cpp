@@ -190,7 +190,7 @@ std::vector<SvoLeaf> voxelizeSvoLeavesGpu(const gpu::VulkanContext& context, con
   for (;;) {
     gpu::Buffer& keys = b.make(capacity * 4, gpu::MemoryUse::DeviceLocal);
     gpu::Buffer& values = b.make(capacity * 4, gpu::MemoryUse::DeviceLocal);
-    Progress progress("voxelising", double(st.slabs), "slabs", options.progress);
+    Progress progress("voxelising", double(st.slabs), "slabs", options.progress, options.progress_sink);
     const uint32_t fill_zero = 0;
     gpu::uploadToBuffer(context, count_buffer, &fill_zero, 4);
     for (uint32_t z0 = 0; z0 < side; z0 += slab_depth) {
@@ -238,7 +238,7 @@ std::vector<SvoLeaf> voxelizeSvoLeavesGpu(const gpu::VulkanContext& context, con
       start = std::chrono::steady_clock::now();
       std::vector<SvoLeaf> leaves(count);
       if (count > 0) {
-        Progress sorting("sorting", 1, "sorts", options.progress);
+        Progress sorting("sorting", 1, "sorts", options.progress, options.progress_sink);
         gpu::Buffer& keys2 = b.make(VkDeviceSize(count) * 4, gpu::MemoryUse::DeviceLocal);
         gpu::Buffer& values2 = b.make(VkDeviceSize(count) * 4, gpu::MemoryUse::DeviceLocal);
         const uint32_t blocks = (count + shader::kRadixBlock - 1) / shader::kRadixBlock;
@@ -271,7 +271,7 @@ SvoTree buildSvoGpu(const gpu::VulkanContext& context, const TubeModel& model, c
   SvoGpuBuildStats& st = stats ? *stats : local;
   const std::vector<SvoLeaf> leaves = voxelizeSvoLeavesGpu(context, model, tubes, grid, options, &st);
   const auto start = std::chrono::steady_clock::now();
-  Progress building("building", 1, "trees", options.progress);
+  Progress building("building", 1, "trees", options.progress, options.progress_sink);
   SvoTree tree = buildSvoTree(model, grid, leaves);
   building.add(1);
   building.finish();
