@@ -6,7 +6,7 @@
 // cache (the same frame), a damaged cache entry rebuilt with a warning,
 // DF AO darkening the SVO frame, and a voxel too fine for the octree as the
 // panel's one-line message with the lines' frame. Offscreen, validation
-// layers on, 30 phantom fibers at 160 x 120.
+// layers on, 15 phantom fibers as 2 mm tubes (a 256^3 octree) at 160 x 120.
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -57,9 +57,9 @@ TEST(ViewerScriptTubes, parsesAllFibersTheSvoKindAndTheVoxel) {
   const auto tubes = [&](size_t i) { return std::get<TubesAction>(std::get<ViewerAction>(steps[i].command)); };
   EXPECT_TRUE(tubes(0).all && !tubes(0).selection && !tubes(0).filtered);
   EXPECT_EQ(tubes(0).radius_mm, 0.8f);
-  EXPECT_EQ(tubes(0).svo, 2);
-  EXPECT_EQ(tubes(0).voxel_mm, 0.25f);
-  EXPECT_EQ(tubes(1).svo, 0);
+  EXPECT_EQ(tubes(0).svo.value_or(-1), 2);
+  EXPECT_EQ(tubes(0).voxel_mm.value_or(-1.0f), 0.25f);
+  EXPECT_EQ(tubes(1).svo.value_or(-1), 0);
   EXPECT_FALSE(tubes(1).voxel_mm.has_value());
   EXPECT_FALSE(tubes(2).svo.has_value());  // keeps the kind
   for (const char* bad : {"tubes every\n", "tubes all svo=bent\n", "tubes all voxel=-1\n", "tubes all voxel=x\n",
@@ -71,7 +71,7 @@ class GpuViewerSvo : public test::GpuTest {
  protected:
   // Runs the viewer on `fibers` phantom fibers with `body` as its script
   // (then quit), the cache in dir_.
-  test::CommandResult view(const std::string& body, uint64_t fibers = 30) {
+  test::CommandResult view(const std::string& body, uint64_t fibers = 15) {
     const std::string script = dir_.file("script.txt");
     test::writeBytes(script, "wait 2\n" + body + "quit\n");
     return test::runCommand("FIBSCOPE_CACHE_DIR='" + dir_.path() + "' " + std::string(FIBSCOPE_EXE) +
@@ -83,13 +83,13 @@ class GpuViewerSvo : public test::GpuTest {
 };
 
 // The octree in the cache is the one buildSvoGpu builds for the tube model
-// of the same fibers (the viewer's phantom .fbl, decoded), radius 1 mm,
+// of the same fibers (the viewer's phantom .fbl, decoded), radius 2 mm,
 // the fibers' own points and the voxel from the data; the second run reads
 // it (no build) and draws the same frame; a truncated entry is rebuilt.
 TEST_F(GpuViewerSvo, theOctreeIsBuildSvoGpusAndASecondRunReadsItFromTheCache) {
-  const auto first = view(shot("lines.png") + "tubes all 1.0 svo=straight\n" + shot("svo.png"));
+  const auto first = view(shot("lines.png") + "tubes all 2.0 svo=straight\n" + shot("svo.png"));
   ASSERT_EQ(first.exit_code, 0) << first.output;
-  EXPECT_NE(first.output.find("svo: 30 tubes"), std::string::npos) << first.output;
+  EXPECT_NE(first.output.find("svo: 15 tubes"), std::string::npos) << first.output;
   EXPECT_NE(first.output.find(" built in "), std::string::npos) << first.output;
   const std::vector<std::string> trees = filesEndingIn(dir_.path(), ".svo"), fbls = filesEndingIn(dir_.path(), ".fbl");
   ASSERT_EQ(trees.size(), 1u);
@@ -98,9 +98,9 @@ TEST_F(GpuViewerSvo, theOctreeIsBuildSvoGpusAndASecondRunReadsItFromTheCache) {
 
   // The reference: the same fibers decoded from the .fbl, built here.
   const Tractogram fibers = readAllStreamlines(*openFbl(fbls[0]));
-  ASSERT_EQ(fibers.streamlineCount(), 30u);
+  ASSERT_EQ(fibers.streamlineCount(), 15u);
   TubeBuildOptions options;
-  options.radius.radius = 1.0f;
+  options.radius.radius = 2.0f;
   options.resample_tolerance = 0.0f;
   const TubeModel model = buildTubes(fibers, options);
   GpuTubes tubes = uploadTubes(context(), model);
@@ -116,18 +116,18 @@ TEST_F(GpuViewerSvo, theOctreeIsBuildSvoGpusAndASecondRunReadsItFromTheCache) {
 
   const test::Png lines = test::readOurPng(dir_.file("lines.png")), svo = test::readOurPng(dir_.file("svo.png"));
   ASSERT_EQ(svo.width, 160u);
-  // 2 mm tubes cover more than 1 px lines.
+  // 4 mm tubes cover more than 1 px lines.
   EXPECT_GT(drawnPixels(svo), drawnPixels(lines) + 300) << drawnPixels(svo) << " vs " << drawnPixels(lines);
 
   const std::string bytes = test::readBytes(trees[0]);
-  const auto second = view("tubes all 1.0 svo=straight\n" + shot("again.png"));
+  const auto second = view("tubes all 2.0 svo=straight\n" + shot("again.png"));
   ASSERT_EQ(second.exit_code, 0) << second.output;
   EXPECT_NE(second.output.find("read from the cache"), std::string::npos) << second.output;
   EXPECT_EQ(test::readBytes(trees[0]), bytes);
   EXPECT_EQ(differingPixels(test::readOurPng(dir_.file("again.png")), svo), 0u);
 
   test::writeBytes(trees[0], bytes.substr(0, bytes.size() / 2));
-  const auto third = view("tubes all 1.0 svo=straight\n" + shot("rebuilt.png"));
+  const auto third = view("tubes all 2.0 svo=straight\n" + shot("rebuilt.png"));
   ASSERT_EQ(third.exit_code, 0) << third.output;
   EXPECT_NE(third.output.find("warning: " + trees[0]), std::string::npos) << third.output;
   EXPECT_NE(third.output.find(" built in "), std::string::npos) << third.output;
@@ -137,7 +137,7 @@ TEST_F(GpuViewerSvo, theOctreeIsBuildSvoGpusAndASecondRunReadsItFromTheCache) {
 
 // Curved tubes are another octree (another cache entry) and another frame.
 TEST_F(GpuViewerSvo, curvedTubesAreAnotherOctree) {
-  const auto r = view("tubes all 1.0 svo=straight voxel=0.5\n" + shot("straight.png") + "tubes all svo=curved\n" +
+  const auto r = view("tubes all 2.0 svo=straight voxel=1.5\n" + shot("straight.png") + "tubes all svo=curved\n" +
                       shot("curved.png") + "tubes off\n" + "wait 1\n" + shot("off.png") + "tubes all svo=off\n" +
                       shot("spline.png"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -154,8 +154,8 @@ TEST_F(GpuViewerSvo, curvedTubesAreAnotherOctree) {
 // built with the octree, and the frame is darker than without AO where
 // tubes crowd, never brighter.
 TEST_F(GpuViewerSvo, distanceFieldAoDarkensTheSvoFrame) {
-  const auto r = view("tubes all 1.0 svo=straight\n" + shot("plain.png") +
-                      "set ao-method df\nset ssao on\ntubes all 1.0 svo=straight\n" + shot("df.png"));
+  const auto r = view("tubes all 2.0 svo=straight\n" + shot("plain.png") +
+                      "set ao-method df\nset ssao on\ntubes all 2.0 svo=straight\n" + shot("df.png"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("distance field: voxel"), std::string::npos) << r.output;
   const test::Png plain = test::readOurPng(dir_.file("plain.png")), df = test::readOurPng(dir_.file("df.png"));
@@ -173,7 +173,7 @@ TEST_F(GpuViewerSvo, distanceFieldAoDarkensTheSvoFrame) {
 // A voxel so fine that the octree would need more than 2^10 voxels a side:
 // the panel's message (on stderr too), no tubes, the lines' frame.
 TEST_F(GpuViewerSvo, aVoxelTooFineIsThePanelsMessage) {
-  const auto r = view(shot("lines.png") + "tubes all 1.0 svo=straight voxel=0.001\n" + "wait 2\n" + shot("bad.png"));
+  const auto r = view(shot("lines.png") + "tubes all 2.0 svo=straight voxel=0.001\n" + "wait 2\n" + shot("bad.png"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("fibscope view: svo: a voxel of 0.001"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("voxels a side"), std::string::npos) << r.output;

@@ -84,13 +84,17 @@ void drawTubesPanel(ViewerState& state, std::vector<ViewerAction>&) {
     if (ImGui::IsItemDeactivatedAfterEdit() && range[0] > 0.0f && range[1] >= range[0])
       t.radius_min = range[0], t.radius_max = range[1];
   }
-  ImGui::SliderFloat("tolerance (mm)", &tolerance, 0.0f, 0.5f, "%.3f");
-  if (ImGui::IsItemHovered())
-    ImGui::SetTooltip("Resampling: the tube's centre line stays within this distance of the fiber (0: every point)");
-  if (ImGui::IsItemDeactivatedAfterEdit() || (!ImGui::IsItemActive() && tolerance != t.tolerance_mm))
-    t.tolerance_mm = std::max(tolerance, 0.0f);
-  for (const SettingInfo& info : renderSettingsTable())
-    if (info.group == "tubes") settingWidget(state.settings, info);
+  if (t.svo == TubesInfo::Svo::None) {  // the octree keeps every point
+    ImGui::SliderFloat("tolerance (mm)", &tolerance, 0.0f, 0.5f, "%.3f");
+    if (ImGui::IsItemHovered())
+      ImGui::SetTooltip("Resampling: the tube's centre line stays within this distance of the fiber (0: every point)");
+    if (ImGui::IsItemDeactivatedAfterEdit() || (!ImGui::IsItemActive() && tolerance != t.tolerance_mm))
+      t.tolerance_mm = std::max(tolerance, 0.0f);
+  }
+  // The spline tubes' settings: the octree's tubes use none of them.
+  if (t.svo == TubesInfo::Svo::None)
+    for (const SettingInfo& info : renderSettingsTable())
+      if (info.group == "tubes") settingWidget(state.settings, info);
   ImGui::Separator();
   if (t.building) {
     buildProgress(t);
