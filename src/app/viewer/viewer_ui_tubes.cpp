@@ -46,7 +46,8 @@ void buildProgress(const TubesInfo& t) {
 void drawTubesPanel(ViewerState& state, std::vector<ViewerAction>&) {
   ImGui::SetNextWindowPos(ImVec2(320, 300), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowSize(ImVec2(320, 0), ImGuiCond_FirstUseEver);
-  if (!ImGui::Begin("Tubes", &state.show_tubes)) {
+  // Auto-sized as the Bundle panel: the build's progress and numbers grow it.
+  if (!ImGui::Begin("Tubes", &state.show_tubes, ImGuiWindowFlags_AlwaysAutoResize)) {
     ImGui::End();
     return;
   }
