@@ -50,7 +50,7 @@ TEST(ViewerScriptTubes, parsesWhichFibersAndTheRadius) {
   EXPECT_EQ(std::get<TubesAction>(std::get<ViewerAction>(data[0].command)).radius_min, 0.3f);
   EXPECT_EQ(std::get<TubesAction>(std::get<ViewerAction>(data[0].command)).radius_max, 2.0f);
   EXPECT_EQ(std::get<TubesAction>(std::get<ViewerAction>(data[1].command)).radius_from, "");
-  for (const char* bad : {"tubes\n", "tubes all\n", "tubes selection 0\n", "tubes selection -1\n",
+  for (const char* bad : {"tubes\n", "tubes some\n", "tubes selection 0\n", "tubes selection -1\n",
                           "tubes selection x\n", "tubes off 1 2\n", "tubes filtered range=2\n",
                           "tubes filtered range=2,1\n", "tubes filtered range=0,1\n"})
     EXPECT_THROW(parseScript(bad, "s.txt"), Error) << bad;

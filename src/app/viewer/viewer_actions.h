@@ -119,8 +119,13 @@ struct AnatomyAction {
 // the selection's, the dissection's kept ones, both or none; radius_mm
 // > 0 also sets the radius, radius_from the per-fiber array the radius
 // comes from ("": the constant radius), radius_min > 0 its range.
+// all: every fiber of the visible models. svo (TubesInfo::Svo: 0 none, 1
+// straight, 2 curved) and voxel_mm (>= 0, 0: from the data) set how they
+// are drawn when given.
 struct TubesAction {
-  bool selection = false, filtered = false;
+  bool selection = false, filtered = false, all = false;
+  std::optional<int> svo;
+  std::optional<float> voxel_mm;
   float radius_mm = 0;
   std::optional<std::string> radius_from;
   float radius_min = 0, radius_max = 0;

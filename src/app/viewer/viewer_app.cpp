@@ -50,6 +50,8 @@
 #include "render/gpu/scene_table.h"
 #include "render/gpu/upscale_pass.h"
 #include "select/fiber_filter.h"
+#include "svo/gpu/gpu_distance_field.h"
+#include "svo/gpu/gpu_svo.h"
 
 namespace fibscope {
 namespace {
@@ -198,8 +200,14 @@ class ViewerApp {
   void syncSelection() { syncSelection(currentScene()); }
   // The tubes panel's fibers of `scene` as tubes (viewer_tubes.h), between frames.
   void syncTubes(const FrameScene& scene);
-  // The frame stages of every renderer: the standard ones and the tubes.
-  FrameStageList frameStages() const { return withTubeStage(standardFrameStages(), tubes_->gpu()); }
+  // The frame stages of every renderer: the standard ones, the spline
+  // tubes, the SVO streamtubes and the tubes' distance field (each runs
+  // only while ViewerTubes holds its buffers).
+  FrameStageList frameStages() const {
+    return withDistanceFieldStage(
+        withSvoStage(withTubeStage(standardFrameStages(), tubes_->gpu()), tubes_->svo(), tubes_->svoSegments()),
+        tubes_->field());
+  }
   void pickAt(const PickAction& pick);
   GpuScene withSelection(const FrameScene& scene) const;
   // An anatomy action (viewer_anatomy.h), between frames; `at_start`: the
@@ -335,7 +343,8 @@ void ViewerApp::createFrameObjects() {
   }
   presentation_ = createPresentation(*context_, width, height);
   imgui_ = std::make_unique<ImGuiLayer>(*context_, presentation_.render_pass, window_ ? window_->handle() : nullptr);
-  tubes_ = std::make_unique<ViewerTubes>(*context_);
+  tubes_ = std::make_unique<ViewerTubes>(
+      *context_, options_.device, options_.validate ? context_->instance().sharedLog() : std::shared_ptr<gpu::DebugLog>{});
   renderer_ = std::make_unique<FrameRenderer>(*context_, width, height, frameStages());
   selection_ = std::make_unique<ViewerSelection>(*context_);
   scene_lengths_ = std::make_unique<GpuSceneFiberLengths>(*context_);
@@ -857,6 +866,9 @@ void ViewerApp::apply(const ViewerAction& action) {
         } else if constexpr (std::is_same_v<A, TubesAction>) {
           state_.tubes.selection = a.selection;
           state_.tubes.filtered = a.filtered;
+          state_.tubes.all = a.all;
+          if (a.svo) state_.tubes.svo = TubesInfo::Svo(*a.svo);
+          if (a.voxel_mm) state_.tubes.voxel_mm = *a.voxel_mm;
           if (a.radius_mm > 0) state_.tubes.radius_mm = a.radius_mm;
           if (a.radius_from) state_.tubes.radius_from = *a.radius_from;
           if (a.radius_min > 0) state_.tubes.radius_min = a.radius_min, state_.tubes.radius_max = a.radius_max;
@@ -1221,14 +1233,15 @@ void ViewerApp::syncTubes(const FrameScene& scene) {
   // bits' state (read only when they change).
   std::string key;
   if (info.wanted() && !scene.empty()) {
-    key = std::to_string(info.selection) + std::to_string(info.filtered) + "|" + std::to_string(info.radius_mm) +
+    key = std::to_string(info.selection) + std::to_string(info.filtered) + std::to_string(info.all) + "|" +
+          std::to_string(info.radius_mm) +
           "|" + info.radius_from + ":" + std::to_string(info.radius_min) + "," + std::to_string(info.radius_max) +
           "|" + std::to_string(info.tolerance_mm) + "|";
     for (size_t k = 0; k < scene.models.size(); ++k)
       key += std::to_string(scenes_[size_t(scene.models[k])]->id) + ":" +
              std::to_string(scene.layout.entries[k].fiber_base) + ",";
-    if (info.selection) key += "|selection " + std::to_string(selection_->revision());
-    if (info.filtered) key += "|" + dissection_->keptKey();
+    if (info.selection && !info.all) key += "|selection " + std::to_string(selection_->revision());
+    if (info.filtered && !info.all) key += "|" + dissection_->keptKey();
   }
   const auto sources = [&]() {
     std::vector<ViewerTubeSource> out(scene.models.size());
@@ -1245,6 +1258,11 @@ void ViewerApp::syncTubes(const FrameScene& scene) {
         out[k].fibers.push_back(fiber);
       }
     };
+    if (info.all) {
+      for (size_t k = 0; k < scene.models.size(); ++k)
+        for (uint32_t f = 0; f < taken[k].size(); ++f) add(k, f);
+      return out;
+    }
     if (info.selection)
       for (const SelectedEntry& e : selection_->entries())
         for (size_t k = 0; k < scene.models.size(); ++k)
@@ -1257,11 +1275,37 @@ void ViewerApp::syncTubes(const FrameScene& scene) {
     }
     return out;
   };
+  ViewerTubeRequest request;
+  request.svo = info.svo;
+  request.voxel_mm = info.voxel_mm;
+  request.distance_field = distanceFieldAoRuns(state_.settings) || distanceFieldShadowsRun(state_.settings);
+  request.df_voxel_mm = state_.settings.df_voxel_mm;
+  const std::string message = info.message;
+  const bool was_building = info.building;
+  std::vector<std::string> warnings;
   try {
-    tubes_->update(key, sources, info);
+    tubes_->update(key, sources, request, info, &warnings);
   } catch (const Error& e) {
     info.message = e.what();
   }
+  for (const std::string& w : warnings) {
+    std::fprintf(stderr, "fibscope view: warning: %s\n", w.c_str());
+    state_.status = w;
+  }
+  // The panel's line, on stderr too (scripts and tests read it there).
+  if (!info.message.empty() && info.message != message) std::fprintf(stderr, "fibscope view: %s\n", info.message.c_str());
+  if (was_building && !info.building && info.message.empty() && info.svo_leaves > 0)
+    std::fprintf(stderr,
+                 "fibscope view: svo: %llu tubes, %llu segments, voxel %.4f mm, %u^3 grid, %llu leaves, nodes %llu "
+                 "bytes, decoration %llu bytes, %s in %.3f s\n",
+                 static_cast<unsigned long long>(info.fibers), static_cast<unsigned long long>(info.segments),
+                 double(info.svo_voxel), info.svo_side, static_cast<unsigned long long>(info.svo_leaves),
+                 static_cast<unsigned long long>(info.svo_nodes_bytes),
+                 static_cast<unsigned long long>(info.svo_decoration_bytes),
+                 info.svo_from_cache ? "read from the cache" : "built", info.svo_seconds);
+  if (was_building && !info.building && info.message.empty() && info.df_bytes > 0)
+    std::fprintf(stderr, "fibscope view: distance field: voxel %.4f mm, %.1f MB, built in %.3f s\n",
+                 double(info.df_voxel), double(info.df_bytes) / 1e6, info.df_seconds);
 }
 
 PickResult ViewerApp::pickDrawn(double x, double y) {

@@ -273,20 +273,36 @@ std::variant<ViewerAction, WaitFrames, WaitLoaded, WaitExported, WaitBundled> pa
     return ViewerAction{ResizeAction{uint32_t(width), uint32_t(height)}};
   }
   if (name == "tubes") {
-    expectArguments(w, 1, 4, "tubes selection|filtered|both|off [RADIUS_MM] [from=ARRAY|from=] [range=MIN,MAX]");
+    expectArguments(w, 1, 6,
+                    "tubes selection|filtered|both|all|off [RADIUS_MM] [from=ARRAY|from=] [range=MIN,MAX] "
+                    "[svo=straight|curved|off] [voxel=MM]");
     TubesAction t;
     const std::string_view which = w[1];
-    if (which != "selection" && which != "filtered" && which != "both" && which != "off")
-      throw Error("tubes: expected selection, filtered, both or off, got '" + std::string(which) + "'");
+    if (which != "selection" && which != "filtered" && which != "both" && which != "all" && which != "off")
+      throw Error("tubes: expected selection, filtered, both, all or off, got '" + std::string(which) + "'");
     t.selection = which == "selection" || which == "both";
     t.filtered = which == "filtered" || which == "both";
-    bool seen[3] = {false, false, false};  // radius, from=, range=: each once
+    t.all = which == "all";
+    bool seen[5] = {false, false, false, false, false};  // radius, from=, range=, svo=, voxel=: each once
     for (size_t i = 2; i < w.size(); ++i) {
       const std::string_view word = w[i];
-      const int kind = word.starts_with("from=") ? 1 : (word.starts_with("range=") ? 2 : 0);
+      const int kind = word.starts_with("from=")    ? 1
+                       : word.starts_with("range=") ? 2
+                       : word.starts_with("svo=")   ? 3
+                       : word.starts_with("voxel=") ? 4
+                                                    : 0;
       if (seen[kind]) throw Error("tubes: '" + std::string(word) + "' repeats an argument");
       seen[kind] = true;
-      if (kind == 1) {
+      if (kind == 3) {
+        const std::string_view v = word.substr(4);
+        if (v != "straight" && v != "curved" && v != "off")
+          throw Error("tubes: expected svo=straight, svo=curved or svo=off, got '" + std::string(word) + "'");
+        t.svo = v == "straight" ? 1 : (v == "curved" ? 2 : 0);
+      } else if (kind == 4) {
+        const double voxel = number(word.substr(6), "voxel=MM");
+        if (!(voxel >= 0.0 && voxel < 1e6)) throw Error("tubes: the voxel must be >= 0 mm (0: from the data)");
+        t.voxel_mm = float(voxel);
+      } else if (kind == 1) {
         t.radius_from = std::string(word.substr(5));
       } else if (kind == 2) {
         std::vector<double> range;

@@ -12,6 +12,7 @@
 
 #include "app/viewer/dissection.h"
 #include "bundling/bundle_params.h"
+#include "core/progress.h"
 #include "render/camera.h"
 #include "render/render_settings.h"
 
@@ -103,6 +104,16 @@ struct AnatomyInfo {
 struct TubesInfo {
   bool selection = false;  // the picked selection as tubes
   bool filtered = false;   // the dissection's kept fibers as tubes (with the selection's, when both)
+  bool all = false;        // every fiber of the visible models (then the two above add nothing)
+  // SVO streamtubes (issue 16 item 5): the same fibers drawn from a sparse
+  // voxel octree (svo/gpu/gpu_svo.h) instead of the spline tubes: straight
+  // capsules (svo-straight) or curved tubes (svo-curved); `voxel_mm` the
+  // octree's voxel, 0: chosen from the data (chooseSvoGrid). The octree is
+  // built from the fibers' own points (tolerance 0, as render's
+  // --pipeline svo-*), so `tolerance_mm` is the spline tubes' only.
+  enum class Svo { None, Straight, Curved };
+  Svo svo = Svo::None;
+  float voxel_mm = 0.0f;
   float radius_mm = 0.5f;
   // The radius from a per-fiber array of the models (a .fbl "dps/NAME"
   // section: trk properties, TRX dps) instead, its values' range mapped
@@ -115,7 +126,20 @@ struct TubesInfo {
   uint64_t fibers = 0, nodes = 0, points = 0, segments = 0, bytes = 0;
   double build_seconds = 0;
   std::string message;  // why there are none, or what failed
-  bool wanted() const { return selection || filtered; }
+  // The octree of the last build (svo != None), and the running build's
+  // phase ("tube model", "voxelising", "sorting", "building", "distance
+  // field") with its rate and ETA.
+  uint64_t svo_leaves = 0, svo_nodes_bytes = 0, svo_decoration_bytes = 0;
+  uint32_t svo_side = 0;
+  float svo_voxel = 0;
+  bool svo_from_cache = false;
+  double svo_seconds = 0;  // voxelise + sort + build, or the cache's read
+  // The tubes' distance field (for DF AO / DF shadows, when the settings ask).
+  uint64_t df_bytes = 0;
+  float df_voxel = 0;
+  double df_seconds = 0;
+  std::optional<ProgressSnapshot> progress;
+  bool wanted() const { return selection || filtered || all; }
 };
 
 struct ViewerState {

@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "core/error.h"
+#include "gpu/buffer.h"
 #include "render/fiber_selection.h"
 
 namespace fibscope {
@@ -38,41 +39,169 @@ TubeRadius dataRadius(const Tractogram& fibers, const TubesInfo& info) {
   return r;
 }
 
+// The request's part of the key (what the worker builds beside the model).
+std::string requestText(const ViewerTubeRequest& r) {
+  return "|svo " + std::to_string(int(r.svo)) + " " + std::to_string(r.voxel_mm) + "|df " +
+         std::to_string(r.distance_field) + " " + std::to_string(r.df_voxel_mm);
+}
+
+double secondsSince(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
 }  // namespace
+
+ViewerTubes::ViewerTubes(const gpu::VulkanContext& context, std::string device_name,
+                         std::shared_ptr<gpu::DebugLog> validation_log, std::string cache_dir)
+    : context_(context),
+      device_name_(std::move(device_name)),
+      validation_log_(std::move(validation_log)),
+      cache_(std::move(cache_dir)) {}
 
 ViewerTubes::~ViewerTubes() {
   if (build_.valid()) build_.wait();
+  clear();
+  worker_context_.reset();
+}
+
+void ViewerTubes::clear() {
+  destroyDistanceField(context_, field_);
+  field_ = {};
+  destroySvo(context_, svo_);
+  svo_ = {};
   destroyTubes(context_, tubes_);
+  tubes_ = {};
+  spline_ = {};
+}
+
+void ViewerTubes::buildOnDevice(const Job& job, Built& b) {
+  const ViewerTubeRequest& r = job.request;
+  const bool svo = r.svo != TubesInfo::Svo::None;
+  const auto report = [shared = shared_](const ProgressSnapshot& s) {
+    std::lock_guard lock(shared->mutex);
+    shared->progress = s;
+  };
+  const auto phase = [&](const char* label) {
+    ProgressSnapshot s;
+    s.label = label;
+    report(s);
+  };
+  if (svo && job.svo_key) {
+    phase("reading the octree cache");
+    const auto t0 = std::chrono::steady_clock::now();
+    b.tree = cache_.lookup(*job.svo_key, b.warnings);
+    if (b.tree) {
+      b.svo_from_cache = true;
+      b.svo_seconds = secondsSince(t0);
+      if (!r.distance_field) return;  // no device work left
+    }
+  }
+  if (!worker_context_) {
+    phase("starting the device");
+    gpu::ContextOptions options;
+    options.device_name = device_name_;
+    options.instance.validation = validation_log_ != nullptr;
+    options.instance.log = validation_log_;
+    worker_context_ = std::make_unique<gpu::VulkanContext>(options);
+  }
+  const gpu::VulkanContext& context = *worker_context_;
+  GpuTubes tubes = uploadTubes(context, b.model);
+  try {
+    if (svo && !b.tree) {
+      const SvoGrid grid = chooseSvoGrid(b.model, r.voxel_mm, r.svo == TubesInfo::Svo::Curved);
+      SvoGpuBuildOptions options;
+      options.progress_sink = report;
+      const auto t0 = std::chrono::steady_clock::now();
+      b.tree = buildSvoGpu(context, b.model, tubes, grid, options, &b.svo_stats);
+      b.svo_seconds = secondsSince(t0);
+      if (job.svo_key) {
+        phase("writing the octree cache");
+        cache_.store(*job.svo_key, *b.tree, b.warnings);
+      }
+    }
+    if (r.distance_field) {
+      phase("distance field");
+      b.field_grid = chooseDistanceFieldGrid(b.model, r.df_voxel_mm);
+      GpuDistanceField field = buildDistanceFieldGpu(context, tubes, b.field_grid);
+      b.field_seconds = field.build_s;
+      try {
+        b.field = downloadDistanceField(context, field);
+      } catch (...) {
+        destroyDistanceField(context, field);
+        throw;
+      }
+      destroyDistanceField(context, field);
+    }
+  } catch (...) {
+    destroyTubes(context, tubes);
+    throw;
+  }
+  destroyTubes(context, tubes);
 }
 
 void ViewerTubes::start(Job job) {
-  build_ = std::async(std::launch::async, [job = std::move(job)]() {
+  {
+    std::lock_guard lock(shared_->mutex);
+    shared_->progress.reset();
+  }
+  // Builds never overlap (one future at a time), so the worker's context
+  // and the cache are used by one thread at a time.
+  build_ = std::async(std::launch::async, [this, job = std::move(job)]() {
     Built b;
     b.key = job.key;
     const auto t0 = std::chrono::steady_clock::now();
     try {
+      {
+        ProgressSnapshot s;
+        s.label = "tube model";
+        std::lock_guard lock(shared_->mutex);
+        shared_->progress = s;
+      }
       b.model = buildTubes(job.fibers, job.options, &b.stats);
-      // buildTubes numbers fibers by their index in job.fibers.
+      // buildTubes numbers fibers by their index in job.fibers (the
+      // octree's lists index segments, not fibers: the tree does not
+      // depend on the scene's numbering).
       for (TubeModel::Tube& t : b.model.tubes) t.fiber = job.scene_ids[t.fiber];
       for (shader::TubeSegment& s : b.model.segments) s.fiber = job.scene_ids[s.fiber];
+      b.seconds = secondsSince(t0);
+      if (job.request.svo != TubesInfo::Svo::None || job.request.distance_field) buildOnDevice(job, b);
     } catch (const Error& e) {
       b.error = e.what();
     }
-    b.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (b.seconds == 0) b.seconds = secondsSince(t0);
     return b;
   });
 }
 
 void ViewerTubes::upload(Built& built, TubesInfo& info) {
-  destroyTubes(context_, tubes_);
-  tubes_ = {};
+  clear();
   info.fibers = info.nodes = info.points = info.segments = info.bytes = 0;
+  info.svo_leaves = info.svo_nodes_bytes = info.svo_decoration_bytes = 0;
+  info.svo_side = 0;
+  info.svo_voxel = 0;
+  info.svo_from_cache = false;
+  info.svo_seconds = 0;
+  info.df_bytes = 0;
+  info.df_voxel = 0;
+  info.df_seconds = 0;
   info.build_seconds = built.seconds;
   info.message = built.error;
   if (!built.error.empty()) return;
   try {
     tubes_ = uploadTubes(context_, built.model);
+    if (built.tree) {
+      svo_ = uploadSvo(context_, *built.tree);
+    } else {
+      spline_ = tubes_;  // a view: the tube stage draws them
+    }
+    if (!built.field.empty()) {
+      field_.grid = built.field_grid;
+      field_.build_s = built.field_seconds;
+      field_.values = gpu::createBuffer(context_, built.field.size() * sizeof(float), gpu::MemoryUse::DeviceLocal);
+      gpu::uploadToBuffer(context_, field_.values, built.field.data(), built.field.size() * sizeof(float));
+    }
   } catch (const Error& e) {
+    clear();
     info.message = e.what();
     return;
   }
@@ -81,23 +210,45 @@ void ViewerTubes::upload(Built& built, TubesInfo& info) {
   info.points = built.stats.input_points;
   info.segments = tubes_.segment_count;
   info.bytes = tubes_.nodes.size + tubes_.segments.size;
+  if (built.tree) {
+    info.svo_leaves = built.tree->leaves;
+    info.svo_nodes_bytes = built.tree->nodeBytes();
+    info.svo_decoration_bytes = built.tree->decorationBytes();
+    info.svo_side = built.tree->grid.side();
+    info.svo_voxel = built.tree->grid.voxel;
+    info.svo_from_cache = built.svo_from_cache;
+    info.svo_seconds = built.svo_seconds;
+  }
+  if (!built.field.empty()) {
+    info.df_bytes = built.field_grid.bytes();
+    info.df_voxel = built.field_grid.voxel;
+    info.df_seconds = built.field_seconds;
+  }
 }
 
-bool ViewerTubes::update(const std::string& key, const std::function<std::vector<ViewerTubeSource>()>& sources,
-                         TubesInfo& info) {
+bool ViewerTubes::update(const std::string& tubes_key, const std::function<std::vector<ViewerTubeSource>()>& sources,
+                         const ViewerTubeRequest& request, TubesInfo& info, std::vector<std::string>* warnings) {
   bool changed = false;
+  const std::string key = tubes_key.empty() ? std::string() : tubes_key + requestText(request);
   if (key != wanted_key_) {
     wanted_key_ = key;
     Job job;
     job.key = key;
+    job.request = request;
     job.options.radius.radius = info.radius_mm;
-    job.options.resample_tolerance = info.tolerance_mm;
+    const bool svo = request.svo != TubesInfo::Svo::None;
+    // The octree from the fibers' own points, as render's --pipeline svo-*.
+    job.options.resample_tolerance = svo ? 0.0f : info.tolerance_mm;
+    std::vector<std::string> model_texts;
     try {
+      if (svo && !(request.voxel_mm >= 0.0f && std::isfinite(request.voxel_mm)))
+        throw Error("tubes: the octree's voxel must be > 0 mm (or 0: from the data)");
       // The .fbl files are the models' own: read now, while they are
       // loaded (a model may close before the worker would read it).
       for (const ViewerTubeSource& source : sources()) {
         if (source.fibers.empty()) continue;
         if (!source.fbl) throw Error("tubes: a model's .fbl is not in reach");
+        if (svo && cache_.enabled()) model_texts.push_back(svoCacheModelText(*source.fbl, source.fibers));
         // In chunks of ~1 M points, each appended once (no whole copy).
         size_t next = 0;
         decodeFibers(*source.fbl, source.fibers, size_t(1) << 20, [&](const Tractogram& chunk) {
@@ -110,6 +261,16 @@ bool ViewerTubes::update(const std::string& key, const std::function<std::vector
       }
       if (!(info.radius_mm > 0.0f)) throw Error("tubes: the radius must be > 0 mm");
       if (!info.radius_from.empty()) job.options.radius = dataRadius(job.fibers, info);
+      if (svo && cache_.enabled()) {
+        const TubeRadius& r = job.options.radius;
+        const std::string radius = info.radius_from.empty()
+                                       ? "constant " + std::to_string(r.radius)
+                                       : "from " + info.radius_from + " " + std::to_string(r.radius_min) + "," +
+                                             std::to_string(r.radius_max) + " data " + std::to_string(r.data_min) +
+                                             "," + std::to_string(r.data_max);
+        job.svo_key = svoCacheKey(model_texts, radius, job.options.resample_tolerance, request.voxel_mm,
+                                  request.svo == TubesInfo::Svo::Curved);
+      }
     } catch (const Error& e) {
       job.fibers = {};
       job.scene_ids.clear();
@@ -119,9 +280,10 @@ bool ViewerTubes::update(const std::string& key, const std::function<std::vector
       // Nothing to build: no tubes, at once (a running build is discarded).
       pending_.reset();
       const bool had = tubes_.segment_count > 0;
-      destroyTubes(context_, tubes_);
-      tubes_ = {};
+      clear();
       info.fibers = info.nodes = info.points = info.segments = info.bytes = 0;
+      info.svo_leaves = 0;
+      info.df_bytes = 0;
       if (info.message.empty() && info.wanted()) info.message = "no fibers to show as tubes";
       changed = had;
     } else if (build_.valid()) {
@@ -132,6 +294,7 @@ bool ViewerTubes::update(const std::string& key, const std::function<std::vector
   }
   if (build_.valid() && build_.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
     Built built = build_.get();
+    if (warnings) warnings->insert(warnings->end(), built.warnings.begin(), built.warnings.end());
     if (built.key == wanted_key_) {
       upload(built, info);
       changed = true;
@@ -142,7 +305,13 @@ bool ViewerTubes::update(const std::string& key, const std::function<std::vector
     }
   }
   info.building = build_.valid();
-  if (info.building) info.message.clear();
+  if (info.building) {
+    info.message.clear();
+    std::lock_guard lock(shared_->mutex);
+    info.progress = shared_->progress;
+  } else {
+    info.progress.reset();
+  }
   return changed;
 }
 

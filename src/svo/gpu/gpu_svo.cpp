@@ -265,7 +265,7 @@ std::vector<SvoLeaf> voxelizeSvoLeavesGpu(const gpu::VulkanContext& context, con
   for (;;) {
     gpu::Buffer& keys = b.make(capacity * 4, gpu::MemoryUse::DeviceLocal);
     gpu::Buffer& values = b.make(capacity * 4, gpu::MemoryUse::DeviceLocal);
-    Progress progress("voxelising", double(st.slabs), "slabs", options.progress);
+    Progress progress("voxelising", double(st.slabs), "slabs", options.progress, options.progress_sink);
     const uint32_t fill_zero = 0;
     gpu::uploadToBuffer(context, count_buffer, &fill_zero, 4);
     for (uint32_t slab = 0; slab < st.slabs; ++slab) {
@@ -323,7 +323,7 @@ std::vector<SvoLeaf> voxelizeSvoLeavesGpu(const gpu::VulkanContext& context, con
       start = std::chrono::steady_clock::now();
       std::vector<SvoLeaf> leaves(count);
       if (count > 0) {
-        Progress sorting("sorting", 1, "sorts", options.progress);
+        Progress sorting("sorting", 1, "sorts", options.progress, options.progress_sink);
         gpu::Buffer& keys2 = b.make(VkDeviceSize(count) * 4, gpu::MemoryUse::DeviceLocal);
         gpu::Buffer& values2 = b.make(VkDeviceSize(count) * 4, gpu::MemoryUse::DeviceLocal);
         gpu::Buffer& counts = b.make(VkDeviceSize(radixCountsWords(count)) * 4, gpu::MemoryUse::DeviceLocal);
@@ -355,7 +355,7 @@ SvoTree buildSvoGpu(const gpu::VulkanContext& context, const TubeModel& model, c
   SvoGpuBuildStats& st = stats ? *stats : local;
   const std::vector<SvoLeaf> leaves = voxelizeSvoLeavesGpu(context, model, tubes, grid, options, &st);
   const auto start = std::chrono::steady_clock::now();
-  Progress building("building", 1, "trees", options.progress);
+  Progress building("building", 1, "trees", options.progress, options.progress_sink);
   SvoTree tree = buildSvoTree(model, grid, leaves);
   building.add(1);
   building.finish();

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "core/progress.h"
 #include "gpu/buffer.h"
 #include "gpu/compute_pipeline.h"
 #include "gpu/vulkan_context.h"
@@ -43,6 +44,7 @@ struct SvoGpuBuildOptions {
   // allocating anything when its estimate (estimateSvoMemory) exceeds it.
   uint64_t memory_limit_bytes = 0;
   bool progress = false;  // progress lines on stderr (voxelising, sorting, building)
+  Progress::Sink progress_sink;  // the same reports to a progress bar (the viewer's), when set
 };
 
 struct SvoGpuBuildStats {
