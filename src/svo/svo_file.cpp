@@ -31,6 +31,7 @@ void svoTreeFields(IO& io, Tree& t) {
   io.size(t.references);
   io.array(t.nodes, "nodes");
   io.array(t.decoration, "decoration");
+  io.array(t.lod, "lod");
 }
 
 struct Writer {
@@ -99,7 +100,7 @@ struct Reader {
 
 // The references of a tree read from a file stay inside its arrays (the
 // tracer follows them without checks).
-void validateTree(const std::string& path, const SvoTree& t) {
+void validateTree(const std::string& path, const SvoTree& t, uint64_t segment_count) {
   if (!(t.grid.voxel > 0.0f) || !std::isfinite(t.grid.voxel) || !std::isfinite(t.grid.origin.x) ||
       !std::isfinite(t.grid.origin.y) || !std::isfinite(t.grid.origin.z))
     fail(path, "octree: the grid's voxel must be > 0 and its origin finite");
@@ -124,6 +125,23 @@ void validateTree(const std::string& path, const SvoTree& t) {
   if (leaves != t.leaves)
     fail(path, "octree: the header counts " + std::to_string(t.leaves) + " leaves, the nodes hold " +
                    std::to_string(leaves));
+  // One level-of-detail segment per child block (every node but the root).
+  if (t.lod.size() != (t.nodes.size() - 1) / 8)
+    fail(path, "octree: " + std::to_string(t.lod.size()) + " level-of-detail entries for " +
+                   std::to_string((t.nodes.size() - 1) / 8) + " child blocks");
+  // Segment indices the tracer reads from the tubes' buffer.
+  for (const uint32_t s : t.lod)
+    if (s >= segment_count) fail(path, "octree: level-of-detail segment " + std::to_string(s) + " past the tubes' " +
+                                           std::to_string(segment_count) + " segments");
+  if (segment_count != UINT64_MAX)
+    for (size_t i = 0; i < t.nodes.size(); ++i) {
+      if ((t.nodes[i].ref & shader::kSvoNodeTypeMask) != shader::kSvoNodeLeaf) continue;
+      const uint32_t at = t.nodes[i].ref & shader::kSvoNodeIndexMask;
+      for (uint32_t k = 1; k <= t.decoration[at]; ++k)
+        if (t.decoration[at + k] >= segment_count)
+          fail(path, "octree: node " + std::to_string(i) + " lists segment " + std::to_string(t.decoration[at + k]) +
+                         " past the tubes' " + std::to_string(segment_count) + " segments");
+    }
 }
 
 }  // namespace
@@ -140,7 +158,7 @@ void writeSvoTree(const std::string& path, const SvoTree& tree) {
   out.commit();
 }
 
-SvoTree readSvoTree(const std::string& path) {
+SvoTree readSvoTree(const std::string& path, uint64_t segment_count) {
   std::ifstream in(path, std::ios::binary);
   if (!in) failErrno(path, "cannot open the octree");
   const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -161,7 +179,7 @@ SvoTree readSvoTree(const std::string& path) {
   uint32_t stored = 0;
   std::memcpy(&stored, bytes.data() + r.end, 4);
   if (crc32c(bytes.data(), r.end) != stored) failAt(path, r.end, "octree checksum mismatch (a damaged file)");
-  validateTree(path, tree);
+  validateTree(path, tree, segment_count);
   return tree;
 }
 

@@ -20,7 +20,8 @@ namespace fibscope {
 
 inline constexpr char kSvoFileMagic[8] = {'F', 'S', 'V', 'O', 'T', 'R', 'E', 'E'};
 // Bump when svoTreeFields or the meaning of a member changes.
-inline constexpr uint32_t kSvoFileVersion = 1;
+// 2: the level-of-detail segments (SvoTree::lod).
+inline constexpr uint32_t kSvoFileVersion = 2;
 
 // Writes `tree` to `path` atomically (replacing a file there). Throws Error
 // naming the path when it cannot be written.
@@ -31,7 +32,10 @@ void writeSvoTree(const std::string& path, const SvoTree& tree);
 // or long file, a wrong magic or version, counts beyond the file, a
 // checksum mismatch, or a tree whose node references leave its arrays
 // (node or decoration index out of range, a leaf list running past the
-// decoration, more than kSvoMaxLevels levels, a voxel not > 0).
-SvoTree readSvoTree(const std::string& path);
+// decoration, more than kSvoMaxLevels levels, a voxel not > 0, a
+// level-of-detail entry per child block), and for segment indices (lists,
+// level of detail) at or past `segment_count`: the tubes the tree is
+// traced with (UINT64_MAX: not checked).
+SvoTree readSvoTree(const std::string& path, uint64_t segment_count = UINT64_MAX);
 
 }  // namespace fibscope

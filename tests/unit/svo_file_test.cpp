@@ -5,6 +5,7 @@
 // one-line Errors naming the file.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <string>
 
@@ -39,6 +40,7 @@ void expectSameTree(const SvoTree& a, const SvoTree& b) {
   ASSERT_EQ(a.nodes.size(), b.nodes.size());
   EXPECT_EQ(std::memcmp(a.nodes.data(), b.nodes.data(), a.nodeBytes()), 0);
   EXPECT_EQ(a.decoration, b.decoration);
+  EXPECT_EQ(a.lod, b.lod);
 }
 
 // Rewrites the trailing CRC of `bytes` so that only the content's checks
@@ -119,6 +121,25 @@ TEST(SvoFile, readRejectsReferencesOutsideTheTree) {
   count.leaves += 1;
   writeSvoTree(bad, count);
   EXPECT_NE(test::errorOf([&] { readSvoTree(bad); }).find("leaves"), std::string::npos);
+  SvoTree lod = tree;
+  ASSERT_FALSE(lod.lod.empty());
+  lod.lod.pop_back();
+  writeSvoTree(bad, lod);
+  EXPECT_NE(test::errorOf([&] { readSvoTree(bad); }).find("level-of-detail"), std::string::npos);
+  // Segment indices against the tubes it is traced with: the tree's own
+  // largest index passes, one segment fewer is refused by name.
+  const std::string good = dir.file("good.svo");
+  writeSvoTree(good, tree);
+  uint32_t largest = 0;
+  for (const uint32_t s : tree.lod) largest = std::max(largest, s);
+  for (const shader::SvoNode& n : tree.nodes)
+    if ((n.ref & shader::kSvoNodeTypeMask) == shader::kSvoNodeLeaf) {
+      const uint32_t at = n.ref & shader::kSvoNodeIndexMask;
+      for (uint32_t k = 1; k <= tree.decoration[at]; ++k) largest = std::max(largest, tree.decoration[at + k]);
+    }
+  EXPECT_EQ(test::errorOf([&] { readSvoTree(good, uint64_t(largest) + 1); }), "");
+  const std::string e = test::errorOf([&] { readSvoTree(good, largest); });
+  EXPECT_NE(e.find("past the tubes' " + std::to_string(largest) + " segments"), std::string::npos) << e;
 }
 
 }  // namespace

@@ -94,7 +94,8 @@ SvoCache::SvoCache(std::string dir, uint64_t max_bytes)
 std::string SvoCache::treePath(const SvoCacheKey& key) const { return dir_ + "/" + key.digest() + ".svo"; }
 std::string SvoCache::sidecarPath(const SvoCacheKey& key) const { return dir_ + "/" + key.digest() + ".svo.json"; }
 
-std::optional<SvoTree> SvoCache::lookup(const SvoCacheKey& key, std::vector<std::string>& warnings) {
+std::optional<SvoTree> SvoCache::lookup(const SvoCacheKey& key, std::vector<std::string>& warnings,
+                                        uint64_t segment_count) {
   if (!enabled()) return std::nullopt;
   const std::string tree_path = treePath(key), sidecar = sidecarPath(key);
   std::error_code ec;
@@ -110,7 +111,7 @@ std::optional<SvoTree> SvoCache::lookup(const SvoCacheKey& key, std::vector<std:
   }
   if (!same) return std::nullopt;  // another key's entry of the same digest, or no sidecar yet: built again
   try {
-    SvoTree tree = readSvoTree(tree_path);
+    SvoTree tree = readSvoTree(tree_path, segment_count);
     fs::last_write_time(tree_path, fs::file_time_type::clock::now(), ec);  // LRU
     return tree;
   } catch (const Error& e) {

@@ -61,7 +61,8 @@ class SvoCache {
 
   // The cached tree of `key`, or nothing (a damaged entry is deleted, a
   // warning appended). Never throws for a bad entry.
-  std::optional<SvoTree> lookup(const SvoCacheKey& key, std::vector<std::string>& warnings);
+  std::optional<SvoTree> lookup(const SvoCacheKey& key, std::vector<std::string>& warnings,
+                                uint64_t segment_count = UINT64_MAX);
   // Stores `tree` under `key` and evicts; a directory that cannot be
   // written is a warning, never an error.
   void store(const SvoCacheKey& key, const SvoTree& tree, std::vector<std::string>& warnings);

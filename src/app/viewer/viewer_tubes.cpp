@@ -89,7 +89,7 @@ void ViewerTubes::buildOnDevice(const Job& job, Built& b) {
   if (svo && job.svo_key) {
     phase("reading the octree cache");
     const auto t0 = std::chrono::steady_clock::now();
-    b.tree = cache_.lookup(*job.svo_key, b.warnings);
+    b.tree = cache_.lookup(*job.svo_key, b.warnings, b.model.segments.size());
     if (b.tree) {
       b.svo_from_cache = true;
       b.svo_seconds = secondsSince(t0);
@@ -108,9 +108,11 @@ void ViewerTubes::buildOnDevice(const Job& job, Built& b) {
   GpuTubes tubes = uploadTubes(context, b.model);
   try {
     if (svo && !b.tree) {
-      const SvoGrid grid = chooseSvoGrid(b.model, r.voxel_mm, r.svo == TubesInfo::Svo::Curved);
       SvoGpuBuildOptions options;
       options.progress_sink = report;
+      // A voxel from the data is coarsened until the octree fits the device.
+      const SvoGrid grid =
+          chooseSvoGrid(b.model, r.voxel_mm, r.svo == TubesInfo::Svo::Curved, svoMemoryLimit(context, options));
       const auto t0 = std::chrono::steady_clock::now();
       b.tree = buildSvoGpu(context, b.model, tubes, grid, options, &b.svo_stats);
       b.svo_seconds = secondsSince(t0);
