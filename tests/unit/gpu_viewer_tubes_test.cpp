@@ -105,15 +105,22 @@ TEST_F(GpuViewerTubes, keptFibersShowAsTubesByEitherMethodAndOffGivesTheLinesBac
 }
 
 // The radius from a per-fiber array (a TRX dps, kept in the .fbl as
-// "dps/w"): wider tubes than the constant smallest radius; an array the
-// model lacks is a message and no tubes (the lines' frame exactly).
-TEST_F(GpuViewerTubes, theRadiusComesFromAPerFiberArray) {
+// "dps/w") or a per-point one (a TRX dpv, "dpv/p"): wider tubes than the
+// constant smallest radius; an array the model lacks is a message and no
+// tubes (the lines' frame exactly).
+TEST_F(GpuViewerTubes, theRadiusComesFromAPerFiberOrAPerPointArray) {
   PhantomOptions p;
   p.streamlines = 300;
   Tractogram t = readAllStreamlines(*openPhantom(p));
   DataArray w{"w", 1, "float32", {}};
   for (size_t f = 0; f < t.streamlineCount(); ++f) w.values.push_back(float(f % 5));
   t.per_streamline.push_back(w);
+  // A per-point array: 0 on the first half of every fiber, 1 on the rest
+  // (kept through the .fbl as a dpv section).
+  DataArray pp{"p", 1, "float32", {}};
+  for (size_t f = 0; f < t.streamlineCount(); ++f)
+    for (size_t i = 0; i < t.pointsIn(f); ++i) pp.values.push_back(2 * i < t.pointsIn(f) ? 0.0f : 1.0f);
+  t.per_point.push_back(pp);
   const std::string trx = dir_.file("w.trx");
   writeTractogram(trx, t, TractogramHeader{});
   const auto png = [&](const char* name) { return dir_.file(name); };
@@ -127,6 +134,8 @@ TEST_F(GpuViewerTubes, theRadiusComesFromAPerFiberArray) {
                    "screenshot " + png("thin.png") + " 320x200\n"
                    "tubes filtered from=w range=0.2,2\n"
                    "screenshot " + png("data.png") + " 320x200\n"
+                   "tubes filtered from=p range=0.2,2\n"
+                   "screenshot " + png("points.png") + " 320x200\n"
                    "tubes filtered from=missing\n"
                    "wait 2\n"
                    "screenshot " + png("missing.png") + " 320x200\n"
@@ -136,10 +145,15 @@ TEST_F(GpuViewerTubes, theRadiusComesFromAPerFiberArray) {
                                   script + " " + trx);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const test::Png kept = test::readOurPng(png("kept.png")), thin = test::readOurPng(png("thin.png")),
-                  data = test::readOurPng(png("data.png")), missing = test::readOurPng(png("missing.png"));
+                  data = test::readOurPng(png("data.png")), missing = test::readOurPng(png("missing.png")),
+                  points = test::readOurPng(png("points.png"));
   ASSERT_EQ(data.width, 320u);
   // Four in five fibers get 0.65 to 2 mm instead of 0.2 mm.
   EXPECT_GT(drawnPixels(data), drawnPixels(thin) + 500) << drawnPixels(data) << " vs " << drawnPixels(thin);
+  // The second half of every fiber 2 mm thick instead of 0.2 mm: wider
+  // than the thin tubes, and another picture than the per-fiber radii.
+  EXPECT_GT(drawnPixels(points), drawnPixels(thin) + 500) << drawnPixels(points) << " vs " << drawnPixels(thin);
+  EXPECT_GT(differingPixels(points, data), 500u);
   EXPECT_EQ(differingPixels(missing, kept), 0u);
 }
 

@@ -115,9 +115,10 @@ struct TubesInfo {
   Svo svo = Svo::None;
   float voxel_mm = 0.0f;
   float radius_mm = 0.5f;
-  // The radius from a per-fiber array of the models (a .fbl "dps/NAME"
-  // section: trk properties, TRX dps) instead, its values' range mapped
-  // linearly onto [radius_min, radius_max] mm; empty: radius_mm.
+  // The radius from an array of the models instead: per fiber (a .fbl
+  // "dps/NAME" section: trk properties, TRX dps), else per point ("dpv/NAME":
+  // trk scalars, TRX dpv), its values' range mapped linearly onto
+  // [radius_min, radius_max] mm; empty: radius_mm.
   std::string radius_from;
   float radius_min = 0.2f, radius_max = 1.0f;
   float tolerance_mm = 0.025f;  // resampling (TubeBuildOptions::resample_tolerance)

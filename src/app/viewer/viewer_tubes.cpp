@@ -12,30 +12,61 @@
 namespace fibscope {
 namespace {
 
-// Appends the values of `fibers` in `file`'s per-fiber array `name` (its
-// "dps/NAME" section, one float32 per fiber) to `out`'s per-streamline
-// array "radius". Throws Error naming the file when it has no such array.
+// Appends the values of `fibers` in `file`'s array `name` to `out`'s
+// array "radius": its per-fiber "dps/NAME" section (one float32 per fiber)
+// to out.per_streamline, else its per-point "dpv/NAME" section (one float32
+// per point, found through "fiber_first_point") to out.per_point, whose
+// last fibers.size() streamlines must be those fibers as decoded (their
+// point counts are checked against the table). Throws Error naming the file
+// when it has neither, or the table disagrees.
 void appendFiberValues(const FblFile& file, const std::string& name, const std::vector<uint32_t>& fibers,
                        Tractogram& out) {
-  const FblSection* s = file.find(std::string(kFblSectionDpsPrefix) + name);
-  if (!s || s->dtype != FblDType::kFloat32 || s->components != 1 || s->element_count != file.header().fiber_count)
-    throw Error("tubes: " + file.path() + " has no per-fiber array '" + name + "' of one float per fiber");
+  const uint64_t fiber_count = file.header().fiber_count;
+  if (const FblSection* s = file.find(std::string(kFblSectionDpsPrefix) + name)) {
+    if (s->dtype != FblDType::kFloat32 || s->components != 1 || s->element_count != fiber_count)
+      throw Error("tubes: " + file.path() + ": the per-fiber array '" + name + "' is not one float per fiber");
+    const auto values = file.array<float>(*s);
+    if (out.per_streamline.empty()) out.per_streamline.push_back(DataArray{"radius", 1, "float32", {}});
+    for (const uint32_t f : fibers) out.per_streamline[0].values.push_back(values[f]);
+    return;
+  }
+  const FblSection* s = file.find(std::string(kFblSectionDpvPrefix) + name);
+  const FblSection* first = file.find(kFblSectionFiberFirstPoint);
+  if (!s) throw Error("tubes: " + file.path() + " has no per-fiber or per-point array '" + name + "'");
+  if (s->dtype != FblDType::kFloat32 || s->components != 1 || !first || first->dtype != FblDType::kUint64 ||
+      first->components != 1 || first->element_count != fiber_count + 1)
+    throw Error("tubes: " + file.path() + ": the per-point array '" + name +
+                "' is not one float per point with its fiber_first_point table");
   const auto values = file.array<float>(*s);
-  if (out.per_streamline.empty()) out.per_streamline.push_back(DataArray{"radius", 1, "float32", {}});
-  for (const uint32_t f : fibers) out.per_streamline[0].values.push_back(values[f]);
+  const auto starts = file.array<uint64_t>(*first);
+  if (out.per_point.empty()) out.per_point.push_back(DataArray{"radius", 1, "float32", {}});
+  std::vector<float>& dst = out.per_point[0].values;
+  const size_t base = out.streamlineCount() - fibers.size();
+  for (size_t i = 0; i < fibers.size(); ++i) {
+    const uint64_t a = starts[fibers[i]], b = starts[fibers[i] + 1], n = out.pointsIn(base + i);
+    if (b < a || b - a != n || b > values.size())
+      throw Error("tubes: " + file.path() + ": section 'fiber_first_point': fiber " + std::to_string(fibers[i]) +
+                  " spans points " + std::to_string(a) + ".." + std::to_string(b) + ", but it decodes to " +
+                  std::to_string(n) + " points");
+    dst.insert(dst.end(), values.begin() + ptrdiff_t(a), values.begin() + ptrdiff_t(b));
+  }
 }
 
-// The radius of the per-fiber values appendFiberValues collected: their
-// finite range mapped onto the panel's radii.
+// The radius of the values appendFiberValues collected (per fiber, or per
+// point when the array is one): their finite range mapped onto the
+// panel's radii.
 TubeRadius dataRadius(const Tractogram& fibers, const TubesInfo& info) {
+  if (!fibers.per_streamline.empty() && !fibers.per_point.empty())
+    throw Error("tubes: '" + info.radius_from + "' is a per-fiber array in one model and a per-point one in another");
   TubeRadius r;
-  r.source = TubeRadius::Source::PerFiber;
+  const bool per_point = !fibers.per_point.empty();
+  r.source = per_point ? TubeRadius::Source::PerPoint : TubeRadius::Source::PerFiber;
   r.array = "radius";
   r.radius_min = info.radius_min;
   r.radius_max = info.radius_max;
   if (!(r.radius_min > 0.0f) || !(r.radius_max >= r.radius_min))
     throw Error("tubes: the radius range must be > 0 mm and ordered");
-  fitRadiusDataRange(r, fibers.per_streamline.at(0).values);
+  fitRadiusDataRange(r, per_point ? fibers.per_point.at(0).values : fibers.per_streamline.at(0).values);
   return r;
 }
 

@@ -74,10 +74,10 @@ void drawTubesPanel(ViewerState& state, std::vector<ViewerAction>&) {
   ImGui::SliderFloat("radius (mm)", &radius, 0.05f, 5.0f, "%.2f", ImGuiSliderFlags_Logarithmic);
   if (ImGui::IsItemDeactivatedAfterEdit() || (!ImGui::IsItemActive() && radius != t.radius_mm))
     t.radius_mm = std::max(radius, 0.01f);
-  // The radius from a per-fiber array (committed on Enter or leaving the
-  // field, as the sliders).
+  // The radius from a per-fiber or per-point array (committed on Enter or
+  // leaving the field, as the sliders).
   std::string from = t.radius_from;
-  ImGui::InputTextWithHint("radius from", "a per-fiber array (trk property, TRX dps)", &from);
+  ImGui::InputTextWithHint("radius from", "an array: trk property or scalar, TRX dps or dpv", &from);
   if (ImGui::IsItemDeactivatedAfterEdit()) t.radius_from = from;
   if (!t.radius_from.empty()) {
     float range[2] = {t.radius_min, t.radius_max};
