@@ -4,6 +4,7 @@
 #include <unistd.h>
 #include <zlib.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -157,5 +158,19 @@ Png readOurPng(const std::string& path) {
   return png;
 }
 
+
+size_t differingPixels(const Png& a, const Png& b) {
+  if (a.width != b.width || a.height != b.height) return size_t(std::max(a.width, b.width)) * std::max(a.height, b.height);
+  size_t n = 0;
+  for (size_t i = 0; i + 3 < a.rgba.size(); i += 4)
+    n += a.rgba[i] != b.rgba[i] || a.rgba[i + 1] != b.rgba[i + 1] || a.rgba[i + 2] != b.rgba[i + 2];
+  return n;
+}
+
+size_t drawnPixels(const Png& p) {
+  size_t n = 0;
+  for (size_t i = 0; i + 3 < p.rgba.size(); i += 4) n += p.rgba[i] + p.rgba[i + 1] + p.rgba[i + 2] > 30;
+  return n;
+}
 
 }  // namespace fibscope::test

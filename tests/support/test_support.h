@@ -62,5 +62,9 @@ struct Png {
 // Decodes the PNGs writePngRgba writes (8-bit RGBA, filter 0 on every row);
 // anything else gives an empty image (a test failure where one is read).
 Png readOurPng(const std::string& path);
+// Pixels whose RGB differs between a and b (all of them when the sizes differ).
+size_t differingPixels(const Png& a, const Png& b);
+// Pixels brighter than a black background (R + G + B > 30).
+size_t drawnPixels(const Png& p);
 
 }  // namespace fibscope::test

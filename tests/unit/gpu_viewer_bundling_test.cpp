@@ -17,6 +17,9 @@
 namespace fibscope {
 namespace {
 
+using test::differingPixels;
+using test::drawnPixels;
+
 TEST(ViewerBundlingScript, parsesBundleWaitShowAndSave) {
   const auto steps = parseScript(
       "bundle radius=4 iterations=2 voxel=2 step=1.5 smoothing=0.5 relaxation=0.7 decay=0.9 mode=anisotropic\n"
@@ -78,17 +81,6 @@ class GpuViewerBundling : public ::testing::Test {
   }
   test::TempDir dir_;
 };
-
-size_t differingPixels(const test::Png& a, const test::Png& b) {
-  if (a.width != b.width || a.height != b.height) return a.width * a.height;
-  size_t n = 0;
-  for (uint32_t y = 0; y < a.height; ++y)
-    for (uint32_t x = 0; x < a.width; ++x) {
-      const uint8_t *p = a.at(x, y), *q = b.at(x, y);
-      n += p[0] != q[0] || p[1] != q[1] || p[2] != q[2];
-    }
-  return n;
-}
 
 unsigned long long numberAfter(const std::string& text, const std::string& key) {
   const size_t at = text.find(key);

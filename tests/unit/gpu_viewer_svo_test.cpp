@@ -28,19 +28,8 @@
 namespace fibscope {
 namespace {
 
-size_t differingPixels(const test::Png& a, const test::Png& b) {
-  EXPECT_EQ(a.rgba.size(), b.rgba.size());
-  size_t n = 0;
-  for (size_t i = 0; i + 3 < a.rgba.size() && i + 3 < b.rgba.size(); i += 4)
-    n += a.rgba[i] != b.rgba[i] || a.rgba[i + 1] != b.rgba[i + 1] || a.rgba[i + 2] != b.rgba[i + 2];
-  return n;
-}
-
-size_t drawnPixels(const test::Png& p) {
-  size_t n = 0;
-  for (size_t i = 0; i + 3 < p.rgba.size(); i += 4) n += p.rgba[i] + p.rgba[i + 1] + p.rgba[i + 2] > 30;
-  return n;
-}
+using test::differingPixels;
+using test::drawnPixels;
 
 std::vector<std::string> filesEndingIn(const std::string& dir, const std::string& ending) {
   std::vector<std::string> out;
