@@ -170,7 +170,10 @@ SvoGrid chooseSvoGrid(const TubeModel& model, float voxel_mm, bool curved, uint6
       grid.levels = std::max(levels, 1u);
       // Centred on the tubes' box.
       grid.origin = 0.5f * (lo + hi) - 0.5f * float(grid.side()) * voxel;
-      if (voxel_mm > 0.0f || memory_limit_bytes == 0 ||
+      // At one level the grid cannot shrink further (coarser voxels would
+      // loop for ever where a size-independent part, the segment lists,
+      // exceeds the limit): the build then refuses it, naming the size.
+      if (voxel_mm > 0.0f || memory_limit_bytes == 0 || grid.levels == 1 ||
           estimateSvoMemory(model, grid, svoSlabDepth(grid, kSvoDefaultFieldBudget)).total() <= memory_limit_bytes)
         return grid;
     }

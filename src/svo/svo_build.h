@@ -95,7 +95,8 @@ void svoSegmentBounds(const TubeModel& model, const shader::TubeSegment& s, bool
 // density criterion, the seed's future work): the voxel is coarsened
 // further by 1.25x until estimateSvoMemory (at svoSlabDepth's slabs of
 // kSvoDefaultFieldBudget) fits the limit, so a dense whole-brain set gets a
-// voxel its device can hold instead of a refusal; a given voxel is never
+// voxel its device can hold instead of a refusal, or the one-level grid
+// where no voxel fits (the build then refuses it); a given voxel is never
 // changed (the build refuses it, naming the size it needs).
 SvoGrid chooseSvoGrid(const TubeModel& model, float voxel_mm, bool curved = false, uint64_t memory_limit_bytes = 0);
 

@@ -77,14 +77,16 @@ TEST(SvoMemoryEstimate, boundsTheBuildAndTheDensityCriterionFitsTheLimit) {
   const SvoGrid fitted = chooseSvoGrid(model, 0.0f, false, fine_need / 4);
   EXPECT_GT(fitted.voxel, fine.voxel * 1.2f);
   EXPECT_LE(estimateSvoMemory(model, fitted, svoSlabDepth(fitted, kSvoDefaultFieldBudget)).total(), fine_need / 4);
-  const SvoGrid coarser = SvoGrid{fitted.origin, fitted.voxel / 1.25f, fitted.levels};
-  if (coarser.voxel > fine.voxel * 1.01f) {
-    const SvoGrid prev = chooseSvoGrid(model, coarser.voxel);
-    EXPECT_GT(estimateSvoMemory(model, prev, svoSlabDepth(prev, kSvoDefaultFieldBudget)).total(), fine_need / 4)
-        << "the voxel one step finer would have fitted";
-  }
+  const SvoGrid finer = chooseSvoGrid(model, fitted.voxel / 1.25f);
+  EXPECT_GT(estimateSvoMemory(model, finer, svoSlabDepth(finer, kSvoDefaultFieldBudget)).total(), fine_need / 4)
+      << "the voxel one step finer would have fitted";
   EXPECT_FLOAT_EQ(chooseSvoGrid(model, 0.1f, false, fine_need / 4).voxel, 0.1f);
   EXPECT_FLOAT_EQ(chooseSvoGrid(model, 0.0f, false, fine_need).voxel, fine.voxel);
+  // A limit nothing fits (below the segment lists alone): the one-level
+  // grid, returned (the build refuses it), not an endless coarsening.
+  const SvoGrid none = chooseSvoGrid(model, 0.0f, false, 1);
+  EXPECT_EQ(none.levels, 1u);
+  EXPECT_GT(estimateSvoMemory(model, none, svoSlabDepth(none, kSvoDefaultFieldBudget)).total(), 1u);
 }
 
 // Descends from the root by the code's octants.
