@@ -41,18 +41,21 @@ std::vector<std::string> filesEndingIn(const std::string& dir, const std::string
 }
 
 TEST(ViewerScriptTubes, parsesAllFibersTheSvoKindAndTheVoxel) {
-  const auto steps = parseScript("tubes all 0.8 svo=curved voxel=0.25\ntubes selection svo=off\ntubes both\n", "s.txt");
+  const auto steps = parseScript("tubes all 0.8 svo=curved voxel=0.25 lod=2.5\ntubes selection svo=off\ntubes both\n", "s.txt");
   ASSERT_EQ(steps.size(), 3u);
   const auto tubes = [&](size_t i) { return std::get<TubesAction>(std::get<ViewerAction>(steps[i].command)); };
   EXPECT_TRUE(tubes(0).all && !tubes(0).selection && !tubes(0).filtered);
   EXPECT_EQ(tubes(0).radius_mm, 0.8f);
   EXPECT_EQ(tubes(0).svo.value_or(-1), 2);
   EXPECT_EQ(tubes(0).voxel_mm.value_or(-1.0f), 0.25f);
+  EXPECT_EQ(tubes(0).svo_lod_px.value_or(-1.0f), 2.5f);
+  EXPECT_FALSE(tubes(1).svo_lod_px.has_value());
   EXPECT_EQ(tubes(1).svo.value_or(-1), 0);
   EXPECT_FALSE(tubes(1).voxel_mm.has_value());
   EXPECT_FALSE(tubes(2).svo.has_value());  // keeps the kind
   for (const char* bad : {"tubes every\n", "tubes all svo=bent\n", "tubes all voxel=-1\n", "tubes all voxel=x\n",
-                          "tubes all svo=straight svo=curved\n", "tubes all voxel=1 voxel=2\n"})
+                          "tubes all svo=straight svo=curved\n", "tubes all voxel=1 voxel=2\n", "tubes all lod=-1\n",
+                          "tubes all lod=65\n", "tubes all lod=x\n", "tubes all lod=1 lod=2\n"})
     EXPECT_THROW(parseScript(bad, "s.txt"), Error) << bad;
 }
 
@@ -140,13 +143,21 @@ TEST_F(GpuViewerSvo, curvedTubesAreAnotherOctree) {
 }
 
 // DF AO (issue 16 item 4 in the viewer): the tubes' distance field is
-// built with the octree, and the frame is darker than without AO where
-// tubes crowd, never brighter.
-TEST_F(GpuViewerSvo, distanceFieldAoDarkensTheSvoFrame) {
+// built for the drawn octree (switching DF AO on keeps the tube model and
+// the octree: one octree line in the log), and the frame is darker than
+// without AO where tubes crowd, never brighter. The trace's level of
+// detail is live: lod=8 changes the frame with no build, lod=0 gives the
+// exact frame back bit for bit.
+TEST_F(GpuViewerSvo, distanceFieldAoDarkensTheSvoFrameAndTheLevelOfDetailIsLive) {
   const auto r = view("tubes all 2.0 svo=straight\n" + shot("plain.png") +
-                      "set ao-method df\nset ssao on\ntubes all 2.0 svo=straight\n" + shot("df.png"));
+                      "set ao-method df\nset ssao on\ntubes all 2.0 svo=straight\n" + shot("df.png") +
+                      "tubes all svo=straight lod=8\n" + shot("lod.png") + "tubes all svo=straight lod=0\n" +
+                      shot("exact.png"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("distance field: voxel"), std::string::npos) << r.output;
+  const size_t first = r.output.find("svo: 15 tubes");
+  ASSERT_NE(first, std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("svo: 15 tubes", first + 1), std::string::npos) << "a second octree:\n" << r.output;
   const test::Png plain = test::readOurPng(dir_.file("plain.png")), df = test::readOurPng(dir_.file("df.png"));
   ASSERT_EQ(plain.rgba.size(), df.rgba.size());
   size_t darker = 0, brighter = 0;
@@ -157,6 +168,10 @@ TEST_F(GpuViewerSvo, distanceFieldAoDarkensTheSvoFrame) {
   }
   EXPECT_GT(darker, 200u) << darker;
   EXPECT_LT(brighter, darker / 20 + 1) << brighter << " brighter, " << darker << " darker";
+  // Coarse nodes stand in for their subtrees: more pixels covered.
+  const test::Png lod = test::readOurPng(dir_.file("lod.png"));
+  EXPECT_GT(drawnPixels(lod), drawnPixels(df) + 50) << drawnPixels(lod) << " vs " << drawnPixels(df);
+  EXPECT_EQ(differingPixels(test::readOurPng(dir_.file("exact.png")), df), 0u);
 }
 
 // A voxel so fine that the octree would need more than 2^10 voxels a side:

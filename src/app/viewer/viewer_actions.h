@@ -121,11 +121,12 @@ struct AnatomyAction {
 // comes from ("": the constant radius), radius_min > 0 its range.
 // all: every fiber of the visible models. svo (TubesInfo::Svo: 0 none, 1
 // straight, 2 curved) and voxel_mm (>= 0, 0: from the data) set how they
-// are drawn when given.
+// are drawn when given, svo_lod_px the octree trace's level of detail.
 struct TubesAction {
   bool selection = false, filtered = false, all = false;
   std::optional<int> svo;
   std::optional<float> voxel_mm;
+  std::optional<float> svo_lod_px;
   float radius_mm = 0;
   std::optional<std::string> radius_from;
   float radius_min = 0, radius_max = 0;

@@ -63,7 +63,7 @@ using Clock = std::chrono::steady_clock;
 // device and, once a baseline pipeline asked for them, its raw vertices.
 struct ViewerModel {
   uint64_t id = 0;  // unique per load (the selection names models by it)
-  std::unique_ptr<ModelData> data;
+  std::shared_ptr<ModelData> data;  // shared with a tube build that reads its .fbl
   GpuDataset fiblets;
   GpuRawTractogram raw;
   bool has_raw = false;
@@ -205,7 +205,8 @@ class ViewerApp {
   // only while ViewerTubes holds its buffers).
   FrameStageList frameStages() const {
     return withDistanceFieldStage(
-        withSvoStage(withTubeStage(standardFrameStages(), tubes_->gpu()), tubes_->svo(), tubes_->svoSegments()),
+        withSvoStage(withTubeStage(standardFrameStages(), tubes_->gpu()), tubes_->svo(), tubes_->svoSegments(),
+                     SvoTraceOptions{0.0f, 0, &state_.tubes.svo_lod_px}),
         tubes_->field());
   }
   void pickAt(const PickAction& pick);
@@ -869,6 +870,7 @@ void ViewerApp::apply(const ViewerAction& action) {
           state_.tubes.all = a.all;
           if (a.svo) state_.tubes.svo = TubesInfo::Svo(*a.svo);
           if (a.voxel_mm) state_.tubes.voxel_mm = *a.voxel_mm;
+          if (a.svo_lod_px) state_.tubes.svo_lod_px = *a.svo_lod_px;
           if (a.radius_mm > 0) state_.tubes.radius_mm = a.radius_mm;
           if (a.radius_from) state_.tubes.radius_from = *a.radius_from;
           if (a.radius_min > 0) state_.tubes.radius_min = a.radius_min, state_.tubes.radius_max = a.radius_max;
@@ -1248,7 +1250,7 @@ void ViewerApp::syncTubes(const FrameScene& scene) {
     std::vector<std::vector<bool>> taken(scene.models.size());
     for (size_t k = 0; k < scene.models.size(); ++k) {
       const ViewerModel& m = *scenes_[size_t(scene.models[k])];
-      out[k].fbl = &m.data->fbl;
+      out[k].fbl = std::shared_ptr<const FblFile>(m.data, &m.data->fbl);  // the worker holds the model's file
       out[k].fiber_base = scene.layout.entries[k].fiber_base;
       taken[k].assign(m.data->streamlines, false);
     }
@@ -1294,7 +1296,7 @@ void ViewerApp::syncTubes(const FrameScene& scene) {
   }
   // The panel's line, on stderr too (scripts and tests read it there).
   if (!info.message.empty() && info.message != message) std::fprintf(stderr, "fibscope view: %s\n", info.message.c_str());
-  if (was_building && !info.building && info.message.empty() && info.svo_leaves > 0)
+  if (was_building && !info.building && info.message.empty() && info.svo_leaves > 0 && !info.svo_kept)
     std::fprintf(stderr,
                  "fibscope view: svo: %llu tubes, %llu segments, voxel %.4f mm, %u^3 grid, %llu leaves, nodes %llu "
                  "bytes, decoration %llu bytes, %s in %.3f s\n",

@@ -8,6 +8,7 @@
 
 #include "app/bundle_output.h"
 #include "app/render_options.h"
+#include "app/tube_options.h"
 #include "core/error.h"
 #include "select/cuts.h"
 #include "select/number_list.h"
@@ -273,9 +274,9 @@ std::variant<ViewerAction, WaitFrames, WaitLoaded, WaitExported, WaitBundled> pa
     return ViewerAction{ResizeAction{uint32_t(width), uint32_t(height)}};
   }
   if (name == "tubes") {
-    expectArguments(w, 1, 6,
+    expectArguments(w, 1, 7,
                     "tubes selection|filtered|both|all|off [RADIUS_MM] [from=ARRAY|from=] [range=MIN,MAX] "
-                    "[svo=straight|curved|off] [voxel=MM]");
+                    "[svo=straight|curved|off] [voxel=MM] [lod=PX]");
     TubesAction t;
     const std::string_view which = w[1];
     if (which != "selection" && which != "filtered" && which != "both" && which != "all" && which != "off")
@@ -283,13 +284,14 @@ std::variant<ViewerAction, WaitFrames, WaitLoaded, WaitExported, WaitBundled> pa
     t.selection = which == "selection" || which == "both";
     t.filtered = which == "filtered" || which == "both";
     t.all = which == "all";
-    bool seen[5] = {false, false, false, false, false};  // radius, from=, range=, svo=, voxel=: each once
+    bool seen[6] = {false, false, false, false, false, false};  // radius, from=, range=, svo=, voxel=, lod=: each once
     for (size_t i = 2; i < w.size(); ++i) {
       const std::string_view word = w[i];
       const int kind = word.starts_with("from=")    ? 1
                        : word.starts_with("range=") ? 2
                        : word.starts_with("svo=")   ? 3
                        : word.starts_with("voxel=") ? 4
+                       : word.starts_with("lod=")   ? 5
                                                     : 0;
       if (seen[kind]) throw Error("tubes: '" + std::string(word) + "' repeats an argument");
       seen[kind] = true;
@@ -298,6 +300,12 @@ std::variant<ViewerAction, WaitFrames, WaitLoaded, WaitExported, WaitBundled> pa
         if (v != "straight" && v != "curved" && v != "off")
           throw Error("tubes: expected svo=straight, svo=curved or svo=off, got '" + std::string(word) + "'");
         t.svo = v == "straight" ? 1 : (v == "curved" ? 2 : 0);
+      } else if (kind == 5) {
+        const double lod = number(word.substr(4), "lod=PX");
+        if (!(lod >= 0.0 && lod <= double(kSvoLodMaxPx)))
+          throw Error("tubes: the octree's level of detail must be 0 to " + std::to_string(int(kSvoLodMaxPx)) +
+                      " pixels (0: off)");
+        t.svo_lod_px = float(lod);
       } else if (kind == 4) {
         const double voxel = number(word.substr(6), "voxel=MM");
         if (!(voxel >= 0.0 && voxel < 1e6)) throw Error("tubes: the voxel must be >= 0 mm (0: from the data)");

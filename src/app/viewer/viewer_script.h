@@ -19,11 +19,12 @@
 //   anatomy FILE.nii[.gz]       (the anatomical image shown as slices, read while frames go on; the
 //                               script goes on once it is shown or refused; viewer_anatomy.h)
 //   tubes selection|filtered|both|all|off [RADIUS_MM] [from=ARRAY|from=] [range=MIN,MAX]
-//         [svo=straight|curved|off] [voxel=MM]
+//         [svo=straight|curved|off] [voxel=MM] [lod=PX]
 //                              (those fibers as spline tubes, viewer_tubes.h; all: every fiber of the visible
 //                              models; from=: the radius from a per-fiber array mapped onto range mm, from= alone:
 //                              constant again; svo=: drawn as SVO streamtubes instead, voxel= the octree's voxel,
-//                              0: from the data; the script goes on once they are built; the spline method is
+//                              0: from the data, lod= the octree trace's level of detail in pixels (0: off,
+//                              the exact walk); the script goes on once they are built; the spline method is
 //                              `set tube-method compute|raycast|tess`)
 // the virtual dissection (dissection.h, viewer_dissection.h):
 //   roi-add NAME include|exclude|include_ordered SPEC   (select/region.h's SPEC; a new NAME)

@@ -114,6 +114,10 @@ struct TubesInfo {
   enum class Svo { None, Straight, Curved };
   Svo svo = Svo::None;
   float voxel_mm = 0.0f;
+  // The octree trace's level of detail (SvoTraceOptions::lod_px): a node
+  // smaller than this many pixels stops the ray, hit by its representative
+  // segment; 0: the exact walk. Read at every frame (no rebuild).
+  float svo_lod_px = 0.0f;
   float radius_mm = 0.5f;
   // The radius from an array of the models instead: per fiber (a .fbl
   // "dps/NAME" section: trk properties, TRX dps), else per point ("dpv/NAME":
@@ -134,6 +138,7 @@ struct TubesInfo {
   uint32_t svo_side = 0;
   float svo_voxel = 0;
   bool svo_from_cache = false;
+  bool svo_kept = false;   // the last build kept the octree drawn before (only the field was new)
   double svo_seconds = 0;  // voxelise + sort + build, or the cache's read
   // The tubes' distance field (for DF AO / DF shadows, when the settings ask).
   uint64_t df_bytes = 0;

@@ -55,25 +55,28 @@ void appendFiberValues(const FblFile& file, const std::string& name, const std::
 // The radius of the values appendFiberValues collected (per fiber, or per
 // point when the array is one): their finite range mapped onto the
 // panel's radii.
-TubeRadius dataRadius(const Tractogram& fibers, const TubesInfo& info) {
+TubeRadius dataRadius(const Tractogram& fibers, const std::string& from, float radius_min, float radius_max) {
   if (!fibers.per_streamline.empty() && !fibers.per_point.empty())
-    throw Error("tubes: '" + info.radius_from + "' is a per-fiber array in one model and a per-point one in another");
+    throw Error("tubes: '" + from + "' is a per-fiber array in one model and a per-point one in another");
   TubeRadius r;
   const bool per_point = !fibers.per_point.empty();
   r.source = per_point ? TubeRadius::Source::PerPoint : TubeRadius::Source::PerFiber;
   r.array = "radius";
-  r.radius_min = info.radius_min;
-  r.radius_max = info.radius_max;
+  r.radius_min = radius_min;
+  r.radius_max = radius_max;
   if (!(r.radius_min > 0.0f) || !(r.radius_max >= r.radius_min))
     throw Error("tubes: the radius range must be > 0 mm and ordered");
   fitRadiusDataRange(r, per_point ? fibers.per_point.at(0).values : fibers.per_streamline.at(0).values);
   return r;
 }
 
-// The request's part of the key (what the worker builds beside the model).
-std::string requestText(const ViewerTubeRequest& r) {
-  return "|svo " + std::to_string(int(r.svo)) + " " + std::to_string(r.voxel_mm) + "|df " +
-         std::to_string(r.distance_field) + " " + std::to_string(r.df_voxel_mm);
+// The request's parts of the key (what the worker builds beside the
+// model): the octree's, the distance field's.
+std::string requestSvoText(const ViewerTubeRequest& r) {
+  return "|svo " + std::to_string(int(r.svo)) + " " + std::to_string(r.voxel_mm);
+}
+std::string requestFieldText(const ViewerTubeRequest& r) {
+  return "|df " + std::to_string(r.distance_field) + " " + std::to_string(r.df_voxel_mm);
 }
 
 double secondsSince(std::chrono::steady_clock::time_point t) {
@@ -90,37 +93,108 @@ ViewerTubes::ViewerTubes(const gpu::VulkanContext& context, std::string device_n
       cache_(std::move(cache_dir)) {}
 
 ViewerTubes::~ViewerTubes() {
+  shared_->cancel = true;
   if (build_.valid()) build_.wait();
   clear();
   worker_context_.reset();
 }
 
-void ViewerTubes::clear() {
+void ViewerTubes::clearField() {
   destroyDistanceField(context_, field_);
   field_ = {};
+}
+
+void ViewerTubes::clear() {
+  clearField();
   destroySvo(context_, svo_);
   svo_ = {};
   destroyTubes(context_, tubes_);
   tubes_ = {};
   spline_ = {};
+  drawn_model_.reset();
+  drawn_model_key_.clear();
+  drawn_svo_key_.clear();
+}
+
+std::shared_ptr<const ViewerTubes::ModelPart> ViewerTubes::buildModel(const Job& job) {
+  const ModelOptions& o = job.options;
+  const bool svo = job.request.svo != TubesInfo::Svo::None;
+  const auto cancelled = [shared = shared_]() {
+    if (shared->cancel) throw Error("tubes: the build was cancelled");
+  };
+  const auto report = [shared = shared_](const ProgressSnapshot& s) {
+    std::lock_guard lock(shared->mutex);
+    shared->progress = s;
+  };
+  auto part = std::make_shared<ModelPart>();
+  const auto t0 = std::chrono::steady_clock::now();
+  Tractogram fibers;
+  std::vector<uint32_t> scene_ids;
+  size_t total = 0;
+  for (const ViewerTubeSource& source : job.sources) total += source.fibers.size();
+  {
+    Progress decoding("decoding fibers", double(total), "fibers", false, report);
+    for (const ViewerTubeSource& source : job.sources) {
+      if (source.fibers.empty()) continue;
+      if (!source.fbl) throw Error("tubes: a model's .fbl is not in reach");
+      if (svo && cache_.enabled()) part->model_texts.push_back(svoCacheModelText(*source.fbl, source.fibers));
+      // In chunks of ~1 M points, each appended once (no whole copy).
+      size_t next = 0;
+      decodeFibers(*source.fbl, source.fibers, size_t(1) << 20, [&](const Tractogram& chunk) {
+        cancelled();
+        for (size_t i = 0; i < chunk.streamlineCount(); ++i, ++next) {
+          fibers.addStreamline(chunk.point(chunk.offsets[i]), chunk.pointsIn(i));
+          scene_ids.push_back(source.fiber_base + source.fibers[next]);
+        }
+        decoding.add(double(chunk.streamlineCount()));
+      });
+      if (!o.radius_from.empty()) appendFiberValues(*source.fbl, o.radius_from, source.fibers, fibers);
+    }
+    decoding.finish();
+  }
+  cancelled();
+  TubeBuildOptions options;
+  options.radius.radius = o.radius_mm;
+  // The octree from the fibers' own points, as render's --pipeline svo-*.
+  options.resample_tolerance = svo ? 0.0f : o.tolerance_mm;
+  if (!o.radius_from.empty()) options.radius = dataRadius(fibers, o.radius_from, o.radius_min, o.radius_max);
+  const TubeRadius& r = options.radius;
+  part->radius_text = o.radius_from.empty()
+                          ? "constant " + std::to_string(r.radius)
+                          : "from " + o.radius_from + " " + std::to_string(r.radius_min) + "," +
+                                std::to_string(r.radius_max) + " data " + std::to_string(r.data_min) + "," +
+                                std::to_string(r.data_max);
+  report(ProgressSnapshot{"tube model"});
+  part->model = buildTubes(fibers, options, &part->stats);
+  // buildTubes numbers fibers by their index in `fibers` (the octree's
+  // lists index segments, not fibers: the tree does not depend on the
+  // scene's numbering).
+  for (TubeModel::Tube& t : part->model.tubes) t.fiber = scene_ids[t.fiber];
+  for (shader::TubeSegment& s : part->model.segments) s.fiber = scene_ids[s.fiber];
+  part->seconds = secondsSince(t0);
+  return part;
 }
 
 void ViewerTubes::buildOnDevice(const Job& job, Built& b) {
   const ViewerTubeRequest& r = job.request;
-  const bool svo = r.svo != TubesInfo::Svo::None;
+  const TubeModel& model = b.model->model;
+  const bool svo = r.svo != TubesInfo::Svo::None && !b.svo_kept;
   const auto report = [shared = shared_](const ProgressSnapshot& s) {
     std::lock_guard lock(shared->mutex);
     shared->progress = s;
   };
   const auto phase = [&](const char* label) {
-    ProgressSnapshot s;
-    s.label = label;
-    report(s);
+    if (shared_->cancel) throw Error("tubes: the build was cancelled");
+    report(ProgressSnapshot{label});
   };
-  if (svo && job.svo_key) {
+  std::optional<SvoCacheKey> svo_key;
+  if (svo && cache_.enabled())
+    svo_key = svoCacheKey(b.model->model_texts, b.model->radius_text, 0.0f, r.voxel_mm,
+                          r.svo == TubesInfo::Svo::Curved);
+  if (svo && svo_key) {
     phase("reading the octree cache");
     const auto t0 = std::chrono::steady_clock::now();
-    b.tree = cache_.lookup(*job.svo_key, b.warnings, b.model.segments.size());
+    b.tree = cache_.lookup(*svo_key, b.warnings, model.segments.size());
     if (b.tree) {
       b.svo_from_cache = true;
       b.svo_seconds = secondsSince(t0);
@@ -136,25 +210,26 @@ void ViewerTubes::buildOnDevice(const Job& job, Built& b) {
     worker_context_ = std::make_unique<gpu::VulkanContext>(options);
   }
   const gpu::VulkanContext& context = *worker_context_;
-  GpuTubes tubes = uploadTubes(context, b.model);
+  GpuTubes tubes = uploadTubes(context, model);
   try {
     if (svo && !b.tree) {
       SvoGpuBuildOptions options;
       options.progress_sink = report;
+      options.cancel = &shared_->cancel;
       // A voxel from the data is coarsened until the octree fits the device.
       const SvoGrid grid =
-          chooseSvoGrid(b.model, r.voxel_mm, r.svo == TubesInfo::Svo::Curved, svoMemoryLimit(context, options));
+          chooseSvoGrid(model, r.voxel_mm, r.svo == TubesInfo::Svo::Curved, svoMemoryLimit(context, options));
       const auto t0 = std::chrono::steady_clock::now();
-      b.tree = buildSvoGpu(context, b.model, tubes, grid, options, &b.svo_stats);
+      b.tree = buildSvoGpu(context, model, tubes, grid, options, &b.svo_stats);
       b.svo_seconds = secondsSince(t0);
-      if (job.svo_key) {
+      if (svo_key) {
         phase("writing the octree cache");
-        cache_.store(*job.svo_key, *b.tree, b.warnings);
+        cache_.store(*svo_key, *b.tree, b.warnings);
       }
     }
     if (r.distance_field) {
       phase("distance field");
-      b.field_grid = chooseDistanceFieldGrid(b.model, r.df_voxel_mm);
+      b.field_grid = chooseDistanceFieldGrid(model, r.df_voxel_mm);
       GpuDistanceField field = buildDistanceFieldGpu(context, tubes, b.field_grid);
       b.field_seconds = field.build_s;
       try {
@@ -177,54 +252,62 @@ void ViewerTubes::start(Job job) {
     std::lock_guard lock(shared_->mutex);
     shared_->progress.reset();
   }
+  // What the drawn tubes already have (the builds before this one are
+  // uploaded: one build at a time).
+  if (drawn_model_ && job.model_key == drawn_model_key_) {
+    job.model = drawn_model_;
+    job.keep_svo = job.request.svo != TubesInfo::Svo::None && job.svo_key == drawn_svo_key_ && svo_.nodes.buffer;
+  }
   // Builds never overlap (one future at a time), so the worker's context
   // and the cache are used by one thread at a time.
   build_ = std::async(std::launch::async, [this, job = std::move(job)]() {
     Built b;
     b.key = job.key;
-    const auto t0 = std::chrono::steady_clock::now();
+    b.model_key = job.model_key;
+    b.svo_key = job.svo_key;
     try {
-      {
-        ProgressSnapshot s;
-        s.label = "tube model";
-        std::lock_guard lock(shared_->mutex);
-        shared_->progress = s;
-      }
-      b.model = buildTubes(job.fibers, job.options, &b.stats);
-      // buildTubes numbers fibers by their index in job.fibers (the
-      // octree's lists index segments, not fibers: the tree does not
-      // depend on the scene's numbering).
-      for (TubeModel::Tube& t : b.model.tubes) t.fiber = job.scene_ids[t.fiber];
-      for (shader::TubeSegment& s : b.model.segments) s.fiber = job.scene_ids[s.fiber];
-      b.seconds = secondsSince(t0);
-      if (job.request.svo != TubesInfo::Svo::None || job.request.distance_field) buildOnDevice(job, b);
+      b.model_kept = job.model != nullptr;
+      b.svo_kept = job.keep_svo;
+      b.model = job.model ? job.model : buildModel(job);
+      if ((job.request.svo != TubesInfo::Svo::None && !b.svo_kept) || job.request.distance_field)
+        buildOnDevice(job, b);
     } catch (const Error& e) {
       b.error = e.what();
     }
-    if (b.seconds == 0) b.seconds = secondsSince(t0);
     return b;
   });
 }
 
 void ViewerTubes::upload(Built& built, TubesInfo& info) {
-  clear();
-  info.fibers = info.nodes = info.points = info.segments = info.bytes = 0;
-  info.svo_leaves = info.svo_nodes_bytes = info.svo_decoration_bytes = 0;
-  info.svo_side = 0;
-  info.svo_voxel = 0;
-  info.svo_from_cache = false;
-  info.svo_seconds = 0;
+  const bool keep_model = built.error.empty() && built.model_kept;
+  const bool keep_svo = keep_model && built.svo_kept;
+  if (!keep_model) {
+    clear();
+    info.fibers = info.nodes = info.points = info.segments = info.bytes = 0;
+    info.build_seconds = 0;
+  }
+  if (!keep_svo) {
+    destroySvo(context_, svo_);
+    svo_ = {};
+    info.svo_leaves = info.svo_nodes_bytes = info.svo_decoration_bytes = 0;
+    info.svo_side = 0;
+    info.svo_voxel = 0;
+    info.svo_from_cache = false;
+    info.svo_seconds = 0;
+  }
+  info.svo_kept = keep_svo;
+  clearField();
   info.df_bytes = 0;
   info.df_voxel = 0;
   info.df_seconds = 0;
-  info.build_seconds = built.seconds;
   info.message = built.error;
   if (!built.error.empty()) return;
   try {
-    tubes_ = uploadTubes(context_, built.model);
+    if (!keep_model) tubes_ = uploadTubes(context_, built.model->model);
+    spline_ = {};
     if (built.tree) {
       svo_ = uploadSvo(context_, *built.tree);
-    } else {
+    } else if (!keep_svo) {
       spline_ = tubes_;  // a view: the tube stage draws them
     }
     if (!built.field.empty()) {
@@ -238,11 +321,18 @@ void ViewerTubes::upload(Built& built, TubesInfo& info) {
     info.message = e.what();
     return;
   }
-  info.fibers = built.stats.tubes;
-  info.nodes = built.stats.nodes;
-  info.points = built.stats.input_points;
-  info.segments = tubes_.segment_count;
-  info.bytes = tubes_.nodes.size + tubes_.segments.size;
+  drawn_model_ = built.model;
+  drawn_model_key_ = built.model_key;
+  drawn_svo_key_ = svo_.nodes.buffer ? built.svo_key : std::string();
+  if (!keep_model) {
+    const TubeBuildStats& stats = built.model->stats;
+    info.fibers = stats.tubes;
+    info.nodes = stats.nodes;
+    info.points = stats.input_points;
+    info.segments = tubes_.segment_count;
+    info.bytes = tubes_.nodes.size + tubes_.segments.size;
+    info.build_seconds = built.model->seconds;
+  }
   if (built.tree) {
     info.svo_leaves = built.tree->leaves;
     info.svo_nodes_bytes = built.tree->nodeBytes();
@@ -262,54 +352,33 @@ void ViewerTubes::upload(Built& built, TubesInfo& info) {
 bool ViewerTubes::update(const std::string& tubes_key, const std::function<std::vector<ViewerTubeSource>()>& sources,
                          const ViewerTubeRequest& request, TubesInfo& info, std::vector<std::string>* warnings) {
   bool changed = false;
-  const std::string key = tubes_key.empty() ? std::string() : tubes_key + requestText(request);
+  const bool svo = request.svo != TubesInfo::Svo::None;
+  // The key's parts: the model (its fibers from the octree's own points
+  // or resampled), the octree, the field.
+  const std::string model_key = tubes_key.empty() ? std::string() : tubes_key + (svo ? "|own points" : "|resampled");
+  const std::string svo_key = model_key.empty() ? std::string() : model_key + requestSvoText(request);
+  const std::string key = svo_key.empty() ? std::string() : svo_key + requestFieldText(request);
   if (key != wanted_key_) {
     wanted_key_ = key;
     Job job;
     job.key = key;
+    job.model_key = model_key;
+    job.svo_key = svo_key;
     job.request = request;
-    job.options.radius.radius = info.radius_mm;
-    const bool svo = request.svo != TubesInfo::Svo::None;
-    // The octree from the fibers' own points, as render's --pipeline svo-*.
-    job.options.resample_tolerance = svo ? 0.0f : info.tolerance_mm;
-    std::vector<std::string> model_texts;
+    job.options = {info.radius_mm, info.radius_min, info.radius_max, info.tolerance_mm, info.radius_from};
+    info.message.clear();
+    size_t fibers = 0;
     try {
       if (svo && !(request.voxel_mm >= 0.0f && std::isfinite(request.voxel_mm)))
         throw Error("tubes: the octree's voxel must be > 0 mm (or 0: from the data)");
-      // The .fbl files are the models' own: read now, while they are
-      // loaded (a model may close before the worker would read it).
-      for (const ViewerTubeSource& source : sources()) {
-        if (source.fibers.empty()) continue;
-        if (!source.fbl) throw Error("tubes: a model's .fbl is not in reach");
-        if (svo && cache_.enabled()) model_texts.push_back(svoCacheModelText(*source.fbl, source.fibers));
-        // In chunks of ~1 M points, each appended once (no whole copy).
-        size_t next = 0;
-        decodeFibers(*source.fbl, source.fibers, size_t(1) << 20, [&](const Tractogram& chunk) {
-          for (size_t i = 0; i < chunk.streamlineCount(); ++i, ++next) {
-            job.fibers.addStreamline(chunk.point(chunk.offsets[i]), chunk.pointsIn(i));
-            job.scene_ids.push_back(source.fiber_base + source.fibers[next]);
-          }
-        });
-        if (!info.radius_from.empty()) appendFiberValues(*source.fbl, info.radius_from, source.fibers, job.fibers);
-      }
       if (!(info.radius_mm > 0.0f)) throw Error("tubes: the radius must be > 0 mm");
-      if (!info.radius_from.empty()) job.options.radius = dataRadius(job.fibers, info);
-      if (svo && cache_.enabled()) {
-        const TubeRadius& r = job.options.radius;
-        const std::string radius = info.radius_from.empty()
-                                       ? "constant " + std::to_string(r.radius)
-                                       : "from " + info.radius_from + " " + std::to_string(r.radius_min) + "," +
-                                             std::to_string(r.radius_max) + " data " + std::to_string(r.data_min) +
-                                             "," + std::to_string(r.data_max);
-        job.svo_key = svoCacheKey(model_texts, radius, job.options.resample_tolerance, request.voxel_mm,
-                                  request.svo == TubesInfo::Svo::Curved);
-      }
+      if (!key.empty()) job.sources = sources();
+      for (const ViewerTubeSource& source : job.sources) fibers += source.fibers.size();
     } catch (const Error& e) {
-      job.fibers = {};
-      job.scene_ids.clear();
+      fibers = 0;
       info.message = e.what();
     }
-    if (job.scene_ids.empty()) {
+    if (fibers == 0) {
       // Nothing to build: no tubes, at once (a running build is discarded).
       pending_.reset();
       const bool had = tubes_.segment_count > 0;
@@ -328,9 +397,16 @@ bool ViewerTubes::update(const std::string& tubes_key, const std::function<std::
   if (build_.valid() && build_.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
     Built built = build_.get();
     if (warnings) warnings->insert(warnings->end(), built.warnings.begin(), built.warnings.end());
-    if (built.key == wanted_key_) {
+    // What the build kept must still be drawn (tubes switched off and on
+    // again while it ran clear them): else it is stale, and the request is
+    // made again, in full, unless a newer one waits.
+    const bool kept_drawn = (!built.model_kept || built.model == drawn_model_) &&
+                            (!built.svo_kept || (svo_.nodes.buffer && built.svo_key == drawn_svo_key_));
+    if (built.key == wanted_key_ && kept_drawn) {
       upload(built, info);
       changed = true;
+    } else if (built.key == wanted_key_ && !pending_) {
+      wanted_key_.clear();
     }
     if (pending_) {
       start(std::move(*pending_));

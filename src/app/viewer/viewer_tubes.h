@@ -8,18 +8,23 @@
 // the settings ask for DF AO or DF shadows (gpu_distance_field.h).
 //
 // A change (other fibers, radius, tolerance, SVO kind or voxel, the
-// scene's numbering) decodes the fibers from the models' .fbl on the
-// calling thread (the CPU decoder: ~10^7 points in a fraction of a second)
-// and builds on a thread of its own, so frames go on: the tube model
-// (nodes, derivatives, resampling, frames), then the octree (voxelising,
-// sorting, building; or read from the octree cache, viewer_svo_cache.h)
-// and the distance field on a VulkanContext of the worker's own (the
-// viewer's is the main thread's, as ViewerBundling's). The finished model,
-// tree and field are uploaded between frames by the main thread. A change
-// while a build runs waits for it and starts the next build then (the
-// last request wins; the builds in between are never started).
+// scene's numbering) builds on a thread of its own, so frames go on: the
+// fibers decoded from the models' .fbl (the worker holds each model's
+// file, so a model closed meanwhile stays readable until the build ends),
+// the tube model (nodes, derivatives, resampling, frames), then the octree
+// (voxelising, sorting, building; or read from the octree cache,
+// viewer_svo_cache.h) and the distance field on a VulkanContext of the
+// worker's own (the viewer's is the main thread's, as ViewerBundling's).
+// The finished model, tree and field are uploaded between frames by the
+// main thread. What a change leaves as it was is kept: a new distance
+// field (DF AO or shadows switched) reuses the drawn tube model and
+// octree, another octree the drawn tube model. A change while a build
+// runs waits for it and starts the next build then (the last request
+// wins; the builds in between are never started); destroying the tubes
+// (the viewer quits) cancels a running build at its next step.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <future>
@@ -42,7 +47,7 @@ namespace fibscope {
 
 // One drawn model's fibers to show as tubes.
 struct ViewerTubeSource {
-  const FblFile* fbl = nullptr;   // the model's .fbl (read during update only)
+  std::shared_ptr<const FblFile> fbl;  // the model's .fbl (read by the worker)
   uint32_t fiber_base = 0;        // its first fiber in the scene drawn
   std::vector<uint32_t> fibers;   // within the model, each once
 };
@@ -62,7 +67,7 @@ class ViewerTubes {
   // cache's directory).
   explicit ViewerTubes(const gpu::VulkanContext& context, std::string device_name = {},
                        std::shared_ptr<gpu::DebugLog> validation_log = {}, std::string cache_dir = {});
-  ~ViewerTubes();  // waits for a running build; frees the buffers (the caller keeps the device idle)
+  ~ViewerTubes();  // cancels a running build and waits for it; frees the buffers (the caller keeps the device idle)
   ViewerTubes(const ViewerTubes&) = delete;
   ViewerTubes& operator=(const ViewerTubes&) = delete;
 
@@ -77,30 +82,45 @@ class ViewerTubes {
 
   // Between frames, nothing in flight. `key` names what `sources` would
   // return (fibers, bases, radius, tolerance) and `request`: when it
-  // differs from the last request, sources() is called and a build starts
-  // (or waits for the running one). Uploads a finished build. Fills info's
-  // build fields, progress and message; Error of a decode or build goes to
-  // info.message (the tubes then are none). Returns true when the drawn
-  // tubes changed. Warnings (a damaged cache entry) go to `warnings`.
+  // differs from the last request, sources() is called (on this thread;
+  // it only lists fibers) and a build starts (or waits for the running
+  // one). Uploads a finished build. Fills info's build fields, progress
+  // and message; Error of a decode or build goes to info.message (the
+  // tubes then are none). Returns true when the drawn tubes changed.
+  // Warnings (a damaged cache entry) go to `warnings`.
   bool update(const std::string& key, const std::function<std::vector<ViewerTubeSource>()>& sources,
               const ViewerTubeRequest& request, TubesInfo& info, std::vector<std::string>* warnings = nullptr);
 
  private:
-  // A request decoded and waiting for the worker: the fibers' points (in
-  // the sources' order), each one's scene-global id, the build's options.
-  struct Job {
-    std::string key;
-    Tractogram fibers;
-    std::vector<uint32_t> scene_ids;
-    TubeBuildOptions options;
-    ViewerTubeRequest request;
-    std::optional<SvoCacheKey> svo_key;  // the octree's cache entry (none: the cache is off)
+  // What the tubes are made of (TubesInfo's radius and tolerance).
+  struct ModelOptions {
+    float radius_mm = 0, radius_min = 0, radius_max = 0, tolerance_mm = 0;
+    std::string radius_from;
   };
-  struct Built {
-    std::string key;
+  // A tube model with what its octree's cache key needs.
+  struct ModelPart {
     TubeModel model;
     TubeBuildStats stats;
     double seconds = 0;
+    std::vector<std::string> model_texts;  // svoCacheModelText per source (the cache on)
+    std::string radius_text;                // the radius as the cache key names it
+  };
+  // A request waiting for the worker. `model` (not null): the drawn model,
+  // which the request leaves as it is (no decoding, no model build);
+  // `keep_svo`: the drawn octree too (only the field is new).
+  struct Job {
+    std::string key;
+    std::string model_key, svo_key;  // the key's parts: the model's, the model's and the octree's
+    std::vector<ViewerTubeSource> sources;
+    ModelOptions options;
+    ViewerTubeRequest request;
+    std::shared_ptr<const ModelPart> model;
+    bool keep_svo = false;
+  };
+  struct Built {
+    std::string key, model_key, svo_key;
+    std::shared_ptr<const ModelPart> model;
+    bool model_kept = false, svo_kept = false;  // drawn already: not uploaded again
     std::optional<SvoTree> tree;
     SvoGpuBuildStats svo_stats;
     bool svo_from_cache = false;
@@ -114,12 +134,16 @@ class ViewerTubes {
   struct Shared {  // between the worker and update()
     std::mutex mutex;
     std::optional<ProgressSnapshot> progress;
+    std::atomic<bool> cancel{false};  // the destructor's: the worker stops at its next step
   };
+  // The job's tube model: its fibers decoded and built (on the worker).
+  std::shared_ptr<const ModelPart> buildModel(const Job& job);
   void start(Job job);
   // The octree and the field of `b.model` on the worker's context.
   void buildOnDevice(const Job& job, Built& b);
   void upload(Built& built, TubesInfo& info);
   void clear();
+  void clearField();
 
   const gpu::VulkanContext& context_;
   std::string device_name_;
@@ -132,7 +156,11 @@ class ViewerTubes {
   GpuDistanceField field_;
   std::shared_ptr<Shared> shared_ = std::make_shared<Shared>();
   std::string wanted_key_;  // the last request's key
-  std::optional<Job> pending_;  // decoded, waiting for the running build
+  // What is drawn: its key's parts and model (reused by a request that
+  // leaves them as they are).
+  std::string drawn_model_key_, drawn_svo_key_;
+  std::shared_ptr<const ModelPart> drawn_model_;
+  std::optional<Job> pending_;  // waiting for the running build
   std::future<Built> build_;
 };
 

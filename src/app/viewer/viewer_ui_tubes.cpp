@@ -67,6 +67,11 @@ void drawTubesPanel(ViewerState& state, std::vector<ViewerAction>&) {
       ImGui::SetTooltip("The octree's voxel; 0: half the smallest radius, within the step (chooseSvoGrid)");
     if (ImGui::IsItemDeactivatedAfterEdit() || (!ImGui::IsItemActive() && voxel != t.voxel_mm))
       t.voxel_mm = std::max(voxel, 0.0f);
+    // Live: the trace reads it at every frame.
+    ImGui::SliderFloat("level of detail", &t.svo_lod_px, 0.0f, 8.0f, t.svo_lod_px > 0.0f ? "%.1f px" : "off");
+    if (ImGui::IsItemHovered())
+      ImGui::SetTooltip("A node of the octree smaller than this many pixels stops the ray (its most referenced "
+                        "segment stands in); 0: the exact walk");
   }
   // Edited values rebuild the model once the edit ends (a drag would start
   // a build per step).

@@ -269,6 +269,7 @@ std::vector<SvoLeaf> voxelizeSvoLeavesGpu(const gpu::VulkanContext& context, con
     const uint32_t fill_zero = 0;
     gpu::uploadToBuffer(context, count_buffer, &fill_zero, 4);
     for (uint32_t slab = 0; slab < st.slabs; ++slab) {
+      if (options.cancel && options.cancel->load()) throw Error("svo: the build was cancelled");
       const uint32_t z0 = slab * slab_depth;
       const uint32_t depth = uint32_t(std::min<uint64_t>(slab_depth, side - z0));
       const uint64_t begin = lists.first[slab], end = lists.first[slab + 1];

@@ -6,6 +6,7 @@
 // upload and the ray-tracing frame stage (svo_trace.comp).
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -45,6 +46,9 @@ struct SvoGpuBuildOptions {
   uint64_t memory_limit_bytes = 0;
   bool progress = false;  // progress lines on stderr (voxelising, sorting, building)
   Progress::Sink progress_sink;  // the same reports to a progress bar (the viewer's), when set
+  // Not null: the build throws Error ("cancelled") at the next slab once it
+  // holds true (the viewer quitting during a build).
+  const std::atomic<bool>* cancel = nullptr;
 };
 
 struct SvoGpuBuildStats {
@@ -95,6 +99,8 @@ struct SvoTraceOptions {
   // Not null: uint[2] (device address of a buffer the caller zeroes) that
   // each frame adds the walk's node visits and segment tests to.
   VkDeviceAddress stats = 0;
+  // Not null: read at every frame instead of lod_px (the viewer's panel).
+  const float* live_lod_px = nullptr;
 };
 
 // Surfaces: "svo trace", the octree's straight tubes into the surface

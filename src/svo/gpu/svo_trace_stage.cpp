@@ -1,6 +1,7 @@
 // Surfaces: the SVO's straight streamtubes ray-traced (or its curved ones
 // sphere-traced) by compute
 // (svo_trace.comp), into the surface target like every surface pass.
+#include <algorithm>
 #include <cmath>
 
 #include "gpu/compute_pipeline.h"
@@ -43,7 +44,7 @@ class SvoTraceStage final : public FrameStage {
     push.width = width;
     push.height = height;
     push.curved = svo_->grid.curved ? 1u : 0u;
-    push.lod_px = options_.lod_px;
+    push.lod_px = options_.live_lod_px ? std::clamp(*options_.live_lod_px, 0.0f, 1e6f) : options_.lod_px;
     // The footprint of a pixel at unit distance on the view axis (slightly
     // smaller than off axis: a node there is stopped a little later, never
     // earlier).
