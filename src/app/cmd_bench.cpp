@@ -527,7 +527,8 @@ void addBenchCommand(CLI::App& app) {
   addRenderCliOptions(cmd, o->render);
   cmd->add_option("--compare", o->compare,
                   "Pipelines drawn on the same frames, e.g. compute/two-phase,compute/coverage,compute/none,lines,"
-                  "raw-compute,geometry/frustum,tessellation/none,svo-straight,svo-curved; ratios are to the first");
+                  "raw-compute,geometry/frustum,tessellation/none,mesh/two-phase,mesh-serial/none (mesh: VK_EXT_mesh_shader),"
+                  "svo-straight,svo-curved; ratios are to the first");
   addTubeCliOptions(cmd, o->tubes);
   cmd->add_option("--tube-compare", o->tube_compare,
                   "Tube methods drawn on the same frames, each with every --compare pipeline: none,compute,raycast,tess "
