@@ -17,10 +17,11 @@
 //   - far-view LoD: the compute pipeline's LoD raster draws the same one
 //     segment per fiblet;
 //   - the fiber filter: dropped fibers are not drawn.
-// Runnable everywhere (label gpu / unit): the command line refuses the
-// pipelines in one line with exit 2 where the device lacks the extension,
-// and the task and mesh SPIR-V embedded is of the right stage (the build
-// runs spirv-val on it).
+// Runnable everywhere (label gpu / unit): the extension enabled exactly
+// where the device has it, the pipelines refused before anything is made
+// where it lacks it, in one line with exit 2 on the command line, and the
+// task and mesh SPIR-V embedded of the right stage (the build runs
+// spirv-val on it).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -289,6 +290,43 @@ TEST_F(DeviceMeshPipeline, filteredFibersAreNotDrawn) {
       EXPECT_GT(drawn, 100u);
       EXPECT_EQ(odd_after, 0u);
     }
+  }
+}
+
+// Runs on every device (lavapipe included): the extension is enabled
+// exactly where the device has it, with the EXT's guaranteed limits, and
+// where it is missing the pipelines are refused before anything is made.
+class GpuMeshSupport : public test::GpuTest {};
+
+TEST_F(GpuMeshSupport, meshShadersAreEnabledWhereTheDeviceHasThemAndRefusedElsewhere) {
+  const gpu::MeshShaderSupport& mesh = context().meshShader();
+  std::printf("[ GPU      ] %s: VK_EXT_mesh_shader %s, enabled %s\n", context().info().name.c_str(),
+              context().info().mesh_shader ? "listed" : "not listed", mesh.enabled ? "yes" : "no");
+  if (mesh.enabled) {
+    EXPECT_TRUE(context().info().mesh_shader);
+    EXPECT_NE(mesh.cmdDrawMeshTasks, nullptr);
+    // VK_EXT_mesh_shader's required minimums.
+    EXPECT_GE(mesh.properties.maxMeshOutputVertices, 256u);
+    EXPECT_GE(mesh.properties.maxMeshOutputPrimitives, 256u);
+    EXPECT_GE(mesh.properties.maxMeshWorkGroupInvocations, 128u);
+    EXPECT_GE(mesh.properties.maxTaskPayloadSize, 16384u);
+    for (const RenderPipeline p : kMeshPipelines) EXPECT_EQ(fibletMeshRefusal(context(), p), "") << nameOf(p);
+    return;
+  }
+  EXPECT_EQ(mesh.cmdDrawMeshTasks, nullptr);
+  for (const RenderPipeline p : kMeshPipelines) {
+    SCOPED_TRACE(nameOf(p));
+    const std::string why = fibletMeshRefusal(context(), p);
+    EXPECT_NE(why.find("VK_EXT_mesh_shader not supported by " + context().info().name), std::string::npos) << why;
+    EXPECT_EQ(std::count(why.begin(), why.end(), '\n'), 0) << why;
+    EXPECT_THROW(createFibletMeshPass(context(), p), Error);
+    // A frame asks for it: refused in the stage's check, nothing recorded.
+    const Tractogram fibers = renderPhantom(20, 3);
+    const TractogramUpload upload = uploadTractogram(context(), fibers, "phantom");
+    FrameRenderer renderer(context(), 32, 32);
+    const Camera camera = standardView(tractogramBounds(fibers), StandardView::Axial, 32, 32);
+    EXPECT_THROW(renderer.render(camera, plainSettings(p, CullingMode::TwoPhase, 1.0f), GpuScene{&upload.dataset}),
+                 Error);
   }
 }
 
