@@ -74,6 +74,15 @@ double fractionWithin(const std::vector<uint8_t>& a, const std::vector<uint8_t>&
   return covered > 0 ? double(near) / double(covered) : 1.0;
 }
 
+// `mask` with a frame of kBorder px cleared.
+constexpr uint32_t kBorder = 8;
+std::vector<uint8_t> interior(std::vector<uint8_t> mask) {
+  for (uint32_t y = 0; y < kSize; ++y)
+    for (uint32_t x = 0; x < kSize; ++x)
+      if (x < kBorder || y < kBorder || x >= kSize - kBorder || y >= kSize - kBorder) mask[size_t(y) * kSize + x] = 0;
+  return mask;
+}
+
 RenderSettings plainSettings(RenderPipeline pipeline, CullingMode culling, float width) {
   RenderSettings s;
   s.pipeline = pipeline;
@@ -171,7 +180,14 @@ TEST_F(DeviceMeshPipeline, meshAndMeshSerialDrawWhatTheGeometryPipelineDraws) {
       const auto geometry = render(renderer, view.camera, plainSettings(RenderPipeline::Geometry, CullingMode::None, 1.0f),
                                    GpuScene{&dataset()});
       const auto drawn = render(renderer, view.camera, plainSettings(pipeline, CullingMode::None, 1.0f), GpuScene{&dataset()});
-      const CoverageComparison c = compareCoverage(gbufferMask(drawn), gbufferMask(geometry), kSize, kSize);
+      // Inside a frame of kBorder px: Mesa 25's lavapipe drops the last
+      // pixels (up to 5) of mesh-shader lines that leave the viewport,
+      // where its geometry-shader lines, the CPU reference and the compute
+      // pipeline agree (measured in the very-close view: 29 of 7973 px, all
+      // within 5 px of the edge; mesh-serial's vertices are bit for bit the
+      // geometry shader's, and every interior pixel matched).
+      const CoverageComparison c =
+          compareCoverage(interior(gbufferMask(drawn)), interior(gbufferMask(geometry)), kSize, kSize);
       size_t both = 0, same_fiber = 0, same_segment = 0;
       for (size_t i = 0; i < drawn.size(); ++i) {
         if (drawn[i].fiber == shader::kNoFiberId || geometry[i].fiber == shader::kNoFiberId) continue;
@@ -187,7 +203,7 @@ TEST_F(DeviceMeshPipeline, meshAndMeshSerialDrawWhatTheGeometryPipelineDraws) {
       // float rounding at most (none for mesh-serial, the geometry shader's
       // decode order), the primitive order within a draw may differ (depth
       // ties). Nearly every pixel agrees, none is far off.
-      EXPECT_GE(c.agreement, pipeline == RenderPipeline::MeshSerial ? 0.995 : 0.98) << c.summary();
+      EXPECT_GE(c.agreement, pipeline == RenderPipeline::MeshSerial ? 0.999 : 0.99) << c.summary();
       EXPECT_LE(c.maxDistance(), 1.5) << c.summary();
       EXPECT_GE(double(same_fiber), 0.97 * double(both));
       EXPECT_GE(double(same_segment), 0.95 * double(same_fiber));
@@ -244,7 +260,7 @@ TEST_F(DeviceMeshPipeline, farViewLodDrawsTheComputePipelinesOneSegmentPerFiblet
     SCOPED_TRACE(nameOf(pipeline));
     // Every fiblet is far: one segment each.
     RenderSettings lod = plainSettings(pipeline, CullingMode::Frustum, 1.0f);
-    lod.lod_pixels = 1.0e4f;
+    lod.lod_pixels = 4096.0f;  // the setting's largest
     RenderSettings compute = lod;
     compute.pipeline = RenderPipeline::Compute;
     FrameStats mesh_stats, compute_stats;
