@@ -1,6 +1,6 @@
 # Vulkan and the SPIR-V build step.
 #
-# Every shaders/*.comp|vert|frag|geom|tesc|tese is compiled by glslc (Vulkan
+# Every shaders/*.comp|vert|frag|geom|tesc|tese|task|mesh is compiled by glslc (Vulkan
 # 1.3, -I shaders so that `#include "shared/fiblet.h"` resolves) into
 # build/shaders/<name>.spv, with glslc's depfile so that editing an included
 # header recompiles the shaders that include it. All .spv are then embedded
@@ -34,18 +34,34 @@ endif()
 
 file(GLOB FIBSCOPE_SHADER_SOURCES CONFIGURE_DEPENDS
   ${CMAKE_SOURCE_DIR}/shaders/*.comp ${CMAKE_SOURCE_DIR}/shaders/*.vert ${CMAKE_SOURCE_DIR}/shaders/*.frag
-  ${CMAKE_SOURCE_DIR}/shaders/*.geom ${CMAKE_SOURCE_DIR}/shaders/*.tesc ${CMAKE_SOURCE_DIR}/shaders/*.tese)
+  ${CMAKE_SOURCE_DIR}/shaders/*.geom ${CMAKE_SOURCE_DIR}/shaders/*.tesc ${CMAKE_SOURCE_DIR}/shaders/*.tese
+  ${CMAKE_SOURCE_DIR}/shaders/*.task ${CMAKE_SOURCE_DIR}/shaders/*.mesh)
 set(FIBSCOPE_SHADER_DIR ${CMAKE_BINARY_DIR}/shaders)
 file(MAKE_DIRECTORY ${FIBSCOPE_SHADER_DIR})
+
+# The mesh-shader stages (VK_EXT_mesh_shader) cannot run on every machine
+# that builds them (lavapipe has none), so spirv-val checks their SPIR-V
+# against Vulkan 1.3's rules at build time, where a broken module would
+# otherwise first show on a GPU with mesh shaders.
+find_program(FIBSCOPE_SPIRV_VAL spirv-val)
+if(NOT FIBSCOPE_SPIRV_VAL)
+  message(STATUS "spirv-val not found: the task and mesh shaders' SPIR-V is not validated at build time (install spirv-tools)")
+endif()
 
 set(FIBSCOPE_SPIRV_FILES "")
 foreach(source ${FIBSCOPE_SHADER_SOURCES})
   get_filename_component(name ${source} NAME)
+  get_filename_component(stage ${source} LAST_EXT)
   set(spv ${FIBSCOPE_SHADER_DIR}/${name}.spv)
+  set(validate "")
+  if(FIBSCOPE_SPIRV_VAL AND (stage STREQUAL ".task" OR stage STREQUAL ".mesh"))
+    set(validate COMMAND ${FIBSCOPE_SPIRV_VAL} --target-env vulkan1.3 ${spv})
+  endif()
   add_custom_command(
     OUTPUT ${spv}
     COMMAND ${Vulkan_GLSLC_EXECUTABLE} --target-env=vulkan1.3 -O -Werror
             -I ${CMAKE_SOURCE_DIR}/shaders -MD -MF ${spv}.d -o ${spv} ${source}
+    ${validate}
     DEPENDS ${source}
     DEPFILE ${spv}.d
     COMMENT "glslc ${name}"

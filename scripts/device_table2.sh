@@ -29,7 +29,7 @@ mkdir -p "$tmp"
 "$fibscope" gpu-info > "$out/device.txt" 2>&1 || true
 
 # Every pipeline the binary knows, with and without culling; the graphics
-# ones (lines, geometry, tessellation) run on a datacentre GPU's few raster
+# ones (lines, geometry, tessellation, mesh) run on a datacentre GPU's few raster
 # units, so they run slower there than on a desktop GPU of the same class.
 all_variants() {
   local v=(compute/two-phase compute/frustum compute/none raw-compute lines)
@@ -37,8 +37,13 @@ all_variants() {
   help=$("$fibscope" bench --help 2>&1 || true)
   pipelines=$(grep -- '--pipeline TEXT' <<<"$help" | sed 's/.*one of: \([^;]*\);.*/\1/')
   cullings=$(grep -- '--culling TEXT' <<<"$help" | sed 's/.*one of: \([^;]*\);.*/\1/')
+  # The mesh pipelines (VK_EXT_mesh_shader) only where gpu-info says the
+  # device has them: bench refuses a --compare list naming them otherwise.
+  local mesh=()
+  grep -q '^mesh shaders: enabled' "$out/device.txt" &&
+    mesh=(mesh/two-phase mesh/frustum mesh/none mesh-serial/two-phase mesh-serial/none)
   for extra in compute/coverage geometry/two-phase geometry/none tessellation/two-phase tessellation/none \
-               mesh/two-phase mesh/none mesh-serial/two-phase; do
+               "${mesh[@]}"; do
     # Only the pipelines and culling modes this build names in its help.
     local p=${extra%/*} c=${extra#*/}
     if grep -q -- "\(^\|, \)$p\(,\|$\)" <<<"$pipelines" && grep -q -- "\(^\|, \)$c\(,\|$\)" <<<"$cullings"; then

@@ -32,6 +32,7 @@
 #include "app/tube_options.h"
 #include "core/error.h"
 #include "render/camera.h"
+#include "render/gpu/fiblet_mesh_pass.h"
 #include "render/gpu/frame_renderer.h"
 #include "svo/gpu/gpu_svo.h"
 #include "tubes/gpu/gpu_tubes.h"
@@ -225,6 +226,11 @@ void runBench(const BenchOptions& o) {
   for (const Variant& v : variants) need_points |= !drawsFiblets(v.settings.pipeline);
 
   auto context = createRenderContext(o.render);
+  // A mesh variant on a device without VK_EXT_mesh_shader: refused before
+  // any work, in one line.
+  for (const Variant& v : variants)
+    if (needsMeshShaders(v.settings.pipeline))
+      if (const std::string why = fibletMeshRefusal(*context, v.settings.pipeline); !why.empty()) throw Error(why);
   // The tubes' buffers and the octrees, read by the renderers' tube and
   // SVO stages at each frame and released (by `tubes_owner`) before the
   // renderers and the device.
@@ -527,7 +533,8 @@ void addBenchCommand(CLI::App& app) {
   addRenderCliOptions(cmd, o->render);
   cmd->add_option("--compare", o->compare,
                   "Pipelines drawn on the same frames, e.g. compute/two-phase,compute/coverage,compute/none,lines,"
-                  "raw-compute,geometry/frustum,tessellation/none,svo-straight,svo-curved; ratios are to the first");
+                  "raw-compute,geometry/frustum,tessellation/none,mesh/two-phase,mesh-serial/none (mesh: VK_EXT_mesh_shader),"
+                  "svo-straight,svo-curved; ratios are to the first");
   addTubeCliOptions(cmd, o->tubes);
   cmd->add_option("--tube-compare", o->tube_compare,
                   "Tube methods drawn on the same frames, each with every --compare pipeline: none,compute,raycast,tess "

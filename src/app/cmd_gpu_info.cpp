@@ -70,6 +70,18 @@ void runGpuInfo(const GpuInfoOptions& options) {
   }
   const gpu::VulkanContext context(context_options);
   std::printf("chosen: %s (device %u), device created\n", context.info().name.c_str(), context.info().index);
+  const gpu::MeshShaderSupport& mesh = context.meshShader();
+  if (mesh.enabled) {
+    const VkPhysicalDeviceMeshShaderPropertiesEXT& p = mesh.properties;
+    std::printf("mesh shaders: enabled (pipelines mesh, mesh-serial); output vertices %u, primitives %u, "
+                "mesh workgroup invocations %u (preferred %u), task %u (preferred %u), task payload %u bytes\n",
+                p.maxMeshOutputVertices, p.maxMeshOutputPrimitives, p.maxMeshWorkGroupInvocations,
+                p.maxPreferredMeshWorkGroupInvocations, p.maxTaskWorkGroupInvocations,
+                p.maxPreferredTaskWorkGroupInvocations, p.maxTaskPayloadSize);
+  } else {
+    std::printf("mesh shaders: VK_EXT_mesh_shader not supported by %s (pipelines mesh, mesh-serial unavailable)\n",
+                context.info().name.c_str());
+  }
   if (options.validate)
     std::printf("validation: %d errors, %d warnings\n", context.log().errors(), context.log().warnings());
 }

@@ -38,7 +38,17 @@ GraphicsPipeline createGraphicsPipeline(const VulkanContext& context, const Grap
     VkShaderStageFlagBits stage;
     std::string_view shader;
   };
-  std::vector<Stage> wanted = {{VK_SHADER_STAGE_VERTEX_BIT, desc.vertex_shader}};
+  const bool mesh = !desc.mesh_shader.empty();
+  std::vector<Stage> wanted;
+  if (mesh) {
+    if (!context.meshShader().enabled)
+      throw Error("vulkan: " + std::string(desc.mesh_shader) + ": VK_EXT_mesh_shader not supported by " +
+                  context.info().name);
+    if (!desc.task_shader.empty()) wanted.push_back({VK_SHADER_STAGE_TASK_BIT_EXT, desc.task_shader});
+    wanted.push_back({VK_SHADER_STAGE_MESH_BIT_EXT, desc.mesh_shader});
+  } else {
+    wanted.push_back({VK_SHADER_STAGE_VERTEX_BIT, desc.vertex_shader});
+  }
   if (!desc.tess_control_shader.empty()) {
     wanted.push_back({VK_SHADER_STAGE_TESSELLATION_CONTROL_BIT, desc.tess_control_shader});
     wanted.push_back({VK_SHADER_STAGE_TESSELLATION_EVALUATION_BIT, desc.tess_evaluation_shader});
@@ -117,8 +127,8 @@ GraphicsPipeline createGraphicsPipeline(const VulkanContext& context, const Grap
     info.stageCount = uint32_t(stages.size());
     info.pStages = stages.data();
     info.pTessellationState = desc.tess_control_shader.empty() ? nullptr : &tessellation;
-    info.pVertexInputState = &vertex_input;
-    info.pInputAssemblyState = &assembly;
+    info.pVertexInputState = mesh ? nullptr : &vertex_input;  // (mesh pipelines have neither)
+    info.pInputAssemblyState = mesh ? nullptr : &assembly;
     info.pViewportState = &viewport;
     info.pRasterizationState = &raster;
     info.pMultisampleState = &multisample;

@@ -25,6 +25,12 @@ struct GraphicsPipelineDesc {
   std::string_view tess_control_shader;
   std::string_view tess_evaluation_shader;
   uint32_t patch_control_points = 0;
+  // A mesh pipeline (VK_EXT_mesh_shader enabled on the device:
+  // VulkanContext::meshShader): an optional task shader and a mesh shader
+  // instead of the vertex shader (vertex_shader empty; no vertex input or
+  // input assembly; the topology is the mesh shader's).
+  std::string_view task_shader;
+  std::string_view mesh_shader;
   VkPrimitiveTopology topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
   VkFormat color_format = VK_FORMAT_R8G8B8A8_UNORM;  // UNDEFINED: no colour attachment
   VkFormat depth_format = VK_FORMAT_UNDEFINED;       // UNDEFINED: no depth test

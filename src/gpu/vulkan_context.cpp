@@ -138,21 +138,42 @@ VulkanContext::VulkanContext(const ContextOptions& options) : instance_(options.
   features.features.tessellationShader = available.tessellationShader;
   enabled_ = features.features;
 
+  // The mesh pipelines' stages where the device has them; their limits are
+  // checked when a mesh pipeline is made (fiblet_mesh_pass.cpp).
+  VkPhysicalDeviceMeshShaderFeaturesEXT mesh_features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_FEATURES_EXT};
+  std::vector<const char*> extensions;
+  if (info_.mesh_shader) {
+    VkPhysicalDeviceFeatures2 query{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+    query.pNext = &mesh_features;
+    vkGetPhysicalDeviceFeatures2(info_.handle, &query);
+    if (mesh_features.taskShader && mesh_features.meshShader) {
+      // Only the two stages (not multiview, shading rate or queries).
+      mesh_features = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_FEATURES_EXT};
+      mesh_features.taskShader = VK_TRUE;
+      mesh_features.meshShader = VK_TRUE;
+      features13.pNext = &mesh_features;
+      extensions.push_back(VK_EXT_MESH_SHADER_EXTENSION_NAME);
+      mesh_shader_.enabled = true;
+      VkPhysicalDeviceProperties2 properties2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+      properties2.pNext = &mesh_shader_.properties;
+      vkGetPhysicalDeviceProperties2(info_.handle, &properties2);
+      mesh_shader_.properties.pNext = nullptr;
+    }
+  }
+
   const float priority = 1.0f;
   VkDeviceQueueCreateInfo queue_info{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
   queue_info.queueFamilyIndex = uint32_t(info_.queue_family);
   queue_info.queueCount = 1;
   queue_info.pQueuePriorities = &priority;
 
-  const char* swapchain_extension = VK_KHR_SWAPCHAIN_EXTENSION_NAME;
+  if (surface_ != VK_NULL_HANDLE) extensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
   VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
   info.pNext = &features;
   info.queueCreateInfoCount = 1;
   info.pQueueCreateInfos = &queue_info;
-  if (surface_ != VK_NULL_HANDLE) {
-    info.enabledExtensionCount = 1;
-    info.ppEnabledExtensionNames = &swapchain_extension;
-  }
+  info.enabledExtensionCount = uint32_t(extensions.size());
+  info.ppEnabledExtensionNames = extensions.empty() ? nullptr : extensions.data();
   const VkResult created = vkCreateDevice(info_.handle, &info, nullptr, &device_);
   if (created != VK_SUCCESS) {
     device_ = VK_NULL_HANDLE;
@@ -160,6 +181,11 @@ VulkanContext::VulkanContext(const ContextOptions& options) : instance_(options.
     throwIfFailed(created, "vkCreateDevice on " + info_.name);
   }
   vkGetDeviceQueue(device_, queueFamily(), 0, &queue_);
+  if (mesh_shader_.enabled) {
+    mesh_shader_.cmdDrawMeshTasks =
+        reinterpret_cast<PFN_vkCmdDrawMeshTasksEXT>(vkGetDeviceProcAddr(device_, "vkCmdDrawMeshTasksEXT"));
+    mesh_shader_.enabled = mesh_shader_.cmdDrawMeshTasks != nullptr;
+  }
 
   VkCommandPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
   pool_info.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT | VK_COMMAND_POOL_CREATE_TRANSIENT_BIT;

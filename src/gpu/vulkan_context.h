@@ -35,6 +35,19 @@ struct ContextOptions {
 // `name` matches no device or a device that lacks a feature.
 const DeviceInfo& chooseDevice(std::span<const DeviceInfo> devices, const std::string& name);
 
+// VK_EXT_mesh_shader (the mesh fiblet pipelines), enabled on the device
+// where it has the extension with both its taskShader and meshShader
+// features; never required.
+struct MeshShaderSupport {
+  bool enabled = false;
+  // The device's limits (valid when enabled): maxMeshOutputVertices,
+  // maxMeshOutputPrimitives, maxPreferredMeshWorkGroupInvocations, ...
+  VkPhysicalDeviceMeshShaderPropertiesEXT properties{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_PROPERTIES_EXT};
+  // Extension commands come from vkGetDeviceProcAddr (the loader exports
+  // only core ones); null unless enabled.
+  PFN_vkCmdDrawMeshTasksEXT cmdDrawMeshTasks = nullptr;
+};
+
 class VulkanContext {
  public:
   // Throws as VulkanInstance and chooseDevice do, or Error when the device
@@ -60,6 +73,7 @@ class VulkanContext {
   // tessellationShader where the device has them (the geometry and
   // tessellation fiblet pipelines need them).
   const VkPhysicalDeviceFeatures& enabledFeatures() const { return enabled_; }
+  const MeshShaderSupport& meshShader() const { return mesh_shader_; }
   // The window's surface (VK_NULL_HANDLE without a surface factory); the
   // device can present to it from queue().
   VkSurfaceKHR surface() const { return surface_; }
@@ -73,6 +87,7 @@ class VulkanContext {
   VkPhysicalDeviceMemoryProperties memory_{};
   VkPhysicalDeviceLimits limits_{};
   VkPhysicalDeviceFeatures enabled_{};
+  MeshShaderSupport mesh_shader_;
   VkDevice device_ = VK_NULL_HANDLE;
   VkQueue queue_ = VK_NULL_HANDLE;
   VkCommandPool command_pool_ = VK_NULL_HANDLE;

@@ -27,7 +27,8 @@ std::string_view nameOf(Enum value, const std::pair<std::string_view, Enum> (&na
 constexpr std::pair<std::string_view, RenderPipeline> kPipelines[] = {
     {"compute", RenderPipeline::Compute},   {"lines", RenderPipeline::Lines},
     {"raw-compute", RenderPipeline::RawCompute}, {"geometry", RenderPipeline::Geometry},
-    {"tessellation", RenderPipeline::Tessellation}};
+    {"tessellation", RenderPipeline::Tessellation}, {"mesh", RenderPipeline::Mesh},
+    {"mesh-serial", RenderPipeline::MeshSerial}};
 constexpr std::pair<std::string_view, CullingMode> kCulling[] = {
     {"none", CullingMode::None}, {"frustum", CullingMode::Frustum}, {"two-phase", CullingMode::TwoPhase},
     {"coverage", CullingMode::Coverage}};

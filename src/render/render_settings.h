@@ -23,13 +23,26 @@ enum class RenderPipeline : uint8_t {
   // (one-point patches, isolines); graphics line rasterisation.
   Geometry,
   Tessellation,
+  // VK_EXT_mesh_shader only (paper 3.3; refused in one line elsewhere): a
+  // task shader culls as Compute does, a mesh shader decodes one fiblet per
+  // workgroup with the parallel prefix into a line-list meshlet; MeshSerial
+  // is the paper's "mesh (1 thread)" comparison (one invocation decodes the
+  // fiblet serially). Graphics line rasterisation, as Geometry.
+  Mesh,
+  MeshSerial,
 };
 
 // The pipeline draws the scene's fiblets (scene numbering, the cull), not
 // the raw vertices of the baselines.
 inline bool drawsFiblets(RenderPipeline pipeline) {
   return pipeline == RenderPipeline::Compute || pipeline == RenderPipeline::Geometry ||
-         pipeline == RenderPipeline::Tessellation;
+         pipeline == RenderPipeline::Tessellation || pipeline == RenderPipeline::Mesh ||
+         pipeline == RenderPipeline::MeshSerial;
+}
+
+// The pipeline needs the device's VK_EXT_mesh_shader.
+inline bool needsMeshShaders(RenderPipeline pipeline) {
+  return pipeline == RenderPipeline::Mesh || pipeline == RenderPipeline::MeshSerial;
 }
 
 // Fiblet culling in the fiblet pipelines (drawsFiblets; the baselines never

@@ -91,7 +91,9 @@ constexpr double kMaxSliceCoordinate = 1e6;
 bool isFiblets(const RenderSettings& s) { return drawsFiblets(s.pipeline); }
 // The far-view LoD is the compute pipeline's (the graphics fiblet pipelines
 // draw every culled-in fiblet at full detail).
-bool isCulled(const RenderSettings& s) { return s.pipeline == RenderPipeline::Compute && s.culling != CullingMode::None; }
+bool isCulled(const RenderSettings& s) {
+  return (s.pipeline == RenderPipeline::Compute || needsMeshShaders(s.pipeline)) && s.culling != CullingMode::None;
+}
 bool isCoverage(const RenderSettings& s) { return s.pipeline == RenderPipeline::Compute && s.culling == CullingMode::Coverage; }
 bool isSolid(const RenderSettings& s) { return s.color == ColorMode::Solid; }
 bool isScalar(const RenderSettings& s) { return s.color == ColorMode::Scalar; }
@@ -106,13 +108,13 @@ bool isTessellatedTubes(const RenderSettings& s) { return s.tube_method == TubeM
 
 std::vector<SettingInfo> makeTable() {
   std::vector<SettingInfo> t;
-  t.push_back(choice("pipeline", "pipeline", "compute | lines | raw-compute | geometry | tessellation", 5,
+  t.push_back(choice("pipeline", "pipeline", "compute | lines | raw-compute | geometry | tessellation | mesh | mesh-serial (mesh: VK_EXT_mesh_shader)", 7,
                      [](int v) { return renderPipelineName(RenderPipeline(v)); },
                      getChoice<RenderPipeline, &RenderSettings::pipeline>,
                      setChoice<RenderPipeline, &RenderSettings::pipeline>));
   t.push_back(with(choice("culling", "culling",
-                          "none | frustum | two-phase (fiblet pipelines: compute, geometry, tessellation) | coverage "
-                          "(compute pipeline)",
+                          "none | frustum | two-phase (fiblet pipelines: compute, geometry, tessellation, mesh, "
+                          "mesh-serial) | coverage (compute pipeline)",
                           4,
                           [](int v) { return cullingModeName(CullingMode(v)); },
                           getChoice<CullingMode, &RenderSettings::culling>,

@@ -44,6 +44,7 @@
 #include "phantom/phantom.h"
 #include "render/colormap.h"
 #include "render/gpu/dataset.h"
+#include "render/gpu/fiblet_mesh_pass.h"
 #include "render/gpu/frame_renderer.h"
 #include "render/gpu/pick.h"
 #include "render/gpu/raw_tractogram.h"
@@ -690,6 +691,13 @@ void ViewerApp::dissect(FrameScene& scene, bool now) {
 
 FrameScene ViewerApp::sceneToDraw() {
   FrameScene scene;
+  if (needsMeshShaders(state_.settings.pipeline))
+    if (const std::string why = fibletMeshRefusal(*context_, state_.settings.pipeline); !why.empty()) {
+      // Refused (no VK_EXT_mesh_shader): said in the status line, and the
+      // choice goes back to compute rather than failing every frame.
+      state_.status = why;
+      state_.settings.pipeline = RenderPipeline::Compute;
+    }
   scene.settings = state_.settings;
   state_.baseline_draws_active_only = false;
   const int active = state_.active_model;

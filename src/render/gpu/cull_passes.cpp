@@ -338,6 +338,20 @@ void recordCullLists(VkCommandBuffer cmd, const gpu::VulkanContext& context, con
   const bool two_phase = cull.mode == CullingMode::TwoPhase;
   if (cull.lod_pixels != 0.0f || two_phase != (phase != 0))
     throw Error("cull: the list-only cull is without LoD, and in phases 1 and 2 for TwoPhase only");
+  recordCullCountersReset(cmd, buffers, scene, phase, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT);
+  const uint32_t mode = phase == 1                          ? shader::kCullPhase1
+                        : phase == 2                        ? shader::kCullPhase2
+                        : cull.mode == CullingMode::Frustum ? shader::kCullFrustum
+                                                            : shader::kCullKeptOnly;
+  for (size_t i = 0; i < scene.entries.size(); ++i)
+    recordCull(cmd, context, passes, scene.entries[i], buffers.regions[i], frame, buffers, mode, cull);
+  gpu::computeToComputeBarrier(cmd);
+  markCullHistory(buffers, scene, phase);
+}
+
+void recordCullCountersReset(VkCommandBuffer cmd, CullBuffers& buffers, const SceneLayout& scene, uint32_t phase,
+                             VkPipelineStageFlags2 consumers) {
+  checkRegionsMatch(scene, buffers);
   computeToTransfer(cmd);
   if (phase == 2) {
     // The phase-1 count copies before the resets below (write-after-read).
@@ -348,14 +362,13 @@ void recordCullLists(VkCommandBuffer cmd, const gpu::VulkanContext& context, con
   if (phase == 1 && (!buffers.history_valid || !sameScene(buffers.history_scene, scene)))
     vkCmdFillBuffer(cmd, buffers.visible.buffer, 0, VK_WHOLE_SIZE, 0xFFFFFFFFu);
   resetLists(cmd, buffers);
-  gpu::recordBarrier(cmd, gpu::kTransferToCompute);
-  const uint32_t mode = phase == 1                          ? shader::kCullPhase1
-                        : phase == 2                        ? shader::kCullPhase2
-                        : cull.mode == CullingMode::Frustum ? shader::kCullFrustum
-                                                            : shader::kCullKeptOnly;
-  for (size_t i = 0; i < scene.entries.size(); ++i)
-    recordCull(cmd, context, passes, scene.entries[i], buffers.regions[i], frame, buffers, mode, cull);
-  gpu::computeToComputeBarrier(cmd);
+  // (All transfer stages: validation files the fills under COPY, the spec
+  // under CLEAR; kTransferToCompute's barrier for compute consumers.)
+  gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, consumers,
+                     gpu::kStorageReadWrite);
+}
+
+void markCullHistory(CullBuffers& buffers, const SceneLayout& scene, uint32_t phase) {
   buffers.history_valid = phase == 2;
   if (phase == 2) buffers.history_scene = scene;
 }

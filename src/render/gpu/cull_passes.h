@@ -165,6 +165,17 @@ void recordCulledRaster(VkCommandBuffer cmd, const gpu::VulkanContext& context, 
 void recordCullLists(VkCommandBuffer cmd, const gpu::VulkanContext& context, const CullPasses& passes,
                      const SceneLayout& scene, const GpuFrameTargets& frame, CullBuffers& buffers,
                      const CullFrame& cull, uint32_t phase = 0);
+// For pipelines that cull in a stage of their own (the mesh pipelines' task
+// shader, which only adds to the lists' counts): what recordCullLists does
+// before its culls (the counters reset, the statistics too in phases 0
+// and 1, the visible bits set where the two-phase history is not valid in
+// phase 1), made visible to `consumers` (shader reads and writes); then
+// their draws, then recordCullListStats, and markCullHistory after each.
+void recordCullCountersReset(VkCommandBuffer cmd, CullBuffers& buffers, const SceneLayout& scene, uint32_t phase,
+                             VkPipelineStageFlags2 consumers);
+// The two-phase history valid after phase 2 (recording `scene`), invalid
+// after any other phase.
+void markCullHistory(CullBuffers& buffers, const SceneLayout& scene, uint32_t phase);
 // After recordCullLists and the draws that read its lists (their reads
 // before this with a barrier of the caller's): the counts copied for
 // readCullStats (phase 2: into the second phase's slots).

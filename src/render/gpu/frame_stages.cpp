@@ -15,6 +15,8 @@ FrameStageList standardFrameStages() {
       makeLinesStage,
       makeGeometryStage,
       makeTessellationStage,
+      makeMeshStage,
+      makeMeshSerialStage,
       // Surfaces into the surface target, then merged by depth.
       makeSphereStage,
       makeAnatomyStage,

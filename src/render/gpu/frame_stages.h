@@ -28,6 +28,11 @@ std::unique_ptr<FrameStage> makeLinesStage(const gpu::VulkanContext& context);
 // (fiblet_graphics_pass.h; pipelines made at their first frame).
 std::unique_ptr<FrameStage> makeGeometryStage(const gpu::VulkanContext& context);
 std::unique_ptr<FrameStage> makeTessellationStage(const gpu::VulkanContext& context);
+// "mesh" / "mesh-serial" (or "... 1", "depth pyramid", "... 2"): the task
+// shader's cull and the mesh shader's decode (fiblet_mesh_pass.h;
+// VK_EXT_mesh_shader only, refused in one line without it).
+std::unique_ptr<FrameStage> makeMeshStage(const gpu::VulkanContext& context);
+std::unique_ptr<FrameStage> makeMeshSerialStage(const gpu::VulkanContext& context);
 // Surfaces: "spheres", GpuScene::spheres ray-cast (sphere_surface.comp).
 std::unique_ptr<FrameStage> makeSphereStage(const gpu::VulkanContext& context);
 // Surfaces: "slices", GpuScene::anatomy's slices ray-cast (anatomy_slices.comp).
@@ -47,7 +52,7 @@ std::unique_ptr<FrameStage> makeOrientationStage(const gpu::VulkanContext& conte
 
 // tiles, ssao, shade, post, fxaa: the G-buffer (and surface target) -> RGBA8.
 FrameStageList shadingStages();
-// Everything a frame of any pipeline needs, in order: setup, the five
+// Everything a frame of any pipeline needs, in order: setup, the seven
 // geometry stages, the surface stages, merge, shading, the orientation
 // overlay.
 FrameStageList standardFrameStages();

@@ -23,7 +23,7 @@ class SetupStage final : public FrameStage {
     const RenderPipeline pipeline = frame.settings.pipeline;
     // The graphics pipelines draw into depth attachments of their own.
     const bool graphics = pipeline == RenderPipeline::Lines || pipeline == RenderPipeline::Geometry ||
-                          pipeline == RenderPipeline::Tessellation;
+                          pipeline == RenderPipeline::Tessellation || needsMeshShaders(pipeline);
     // Everything after reads or accumulates into these: compute passes,
     // and the graphics pipelines' shaders (the camera block; the geometry
     // and tessellation stages only where those pipelines run: their stage
@@ -34,6 +34,9 @@ class SetupStage final : public FrameStage {
     if (pipeline == RenderPipeline::Tessellation)
       readers |= VK_PIPELINE_STAGE_2_TESSELLATION_CONTROL_SHADER_BIT |
                  VK_PIPELINE_STAGE_2_TESSELLATION_EVALUATION_SHADER_BIT;
+    // (Only where the mesh stage refuses nothing: the device has the stages.)
+    if (needsMeshShaders(pipeline) && frame.context.meshShader().enabled)
+      readers |= VK_PIPELINE_STAGE_2_TASK_SHADER_BIT_EXT | VK_PIPELINE_STAGE_2_MESH_SHADER_BIT_EXT;
     const gpu::PassBarrier after{VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, readers,
                                  gpu::kStorageReadWrite};
     gpu::PassScope pass(frame.cmd, frame.timer, "clear", after);
