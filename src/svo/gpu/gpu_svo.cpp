@@ -383,7 +383,14 @@ std::string svoBuildSummary(const TubeModel& model, const SvoTree& tree, const S
                 stats.slabs, tree.leaves, tree.leaves_over_4, tree.max_segments_per_leaf,
                 double(tree.nodeBytes()) / 1e6, double(tree.decorationBytes()) / 1e6, double(tree.lodBytes()) / 1e6,
                 stats.voxelize_s, stats.sort_s, stats.tree_s);
-  return text;
+  std::string line = text;
+  const SvoGpuTreeTimes& t = stats.tree_times;
+  if (t.lists_s > 0) {
+    std::snprintf(text, sizeof(text), " (on the device: lists %.3f s, levels and nodes %.3f s, download %.3f s; lod on "
+                  "the CPU %.3f s)", t.lists_s, t.levels_s, t.download_s, t.lod_s);
+    line += text;
+  }
+  return line;
 }
 
 GpuSvo uploadSvo(const gpu::VulkanContext& context, const SvoTree& tree) {
