@@ -17,6 +17,10 @@
 #include "glsl/svo_curve.glsl"
 
 layout(local_size_x_id = WORKGROUP_SIZE_X_ID) in;  // kSvoListsGroupSize
+// Curved tubes (SvoGrid::curved) as a specialisation: a CPU device runs
+// both sides of a branch it cannot prove uniform, and the curved distance
+// costs some thirty capsule distances.
+layout(constant_id = 0) const bool kCurved = false;
 
 layout(push_constant, std430) uniform Push { SvoListsPush pc; };
 
@@ -44,11 +48,10 @@ void main() {
   const TubeNode na = NodesRef(pc.nodes).nodes[s.node], nb = NodesRef(pc.nodes).nodes[s.node + 1u];
   const SvoCapsuleF c = svoCapsuleOf(na, nb);
   const SvoCurveF cv = svoCurveOf(na, nb, s.chord);
-  const bool curved = pc.curved != 0u;
   const vec3 origin = vec3(pc.origin_x, pc.origin_y, pc.origin_z);
   const float pad = c.r + pc.band;
   vec3 bmin = min(c.a, c.b), bmax = max(c.a, c.b);
-  if (curved) svoCurveBounds(cv, bmin, bmax);
+  if (kCurved) svoCurveBounds(cv, bmin, bmax);
   bmin -= pad;
   bmax += pad;
   const int side = int(pc.side);
@@ -61,7 +64,7 @@ void main() {
     const uvec3 v = uvec3(lo) + uvec3(k % n.x, (k / n.x) % n.y, k / (n.x * n.y));
     const vec3 p = origin + (vec3(v) + 0.5) * pc.voxel;
     float u;
-    const float f = curved ? svoCurveDistance(cv, p, u) : svoCapsuleDistance(c, p);
+    const float f = kCurved ? svoCurveDistance(cv, p, u) : svoCapsuleDistance(c, p);
     if (!(abs(f) < pc.band)) continue;
     const uint leaf = findLeaf(svoMorton(v.x, v.y, v.z));
     if (leaf == 0xFFFFFFFFu) continue;

@@ -36,7 +36,8 @@ SVO_BUILD_CONST uint kSvoTreeGroupSize = 256u;    // the other three: one invoca
 // invocations walk the voxels of the segment's box widened by r + band
 // (voxelBox of svo_build.cpp) and, where |f_s(centre)| < band (the
 // curved distance where curved), binary-search the voxel's code among the
-// leaf codes. Phase 0: atomicAdd(offsets[leaf], 1). Phase 1:
+// leaf codes (specialisation constant 0: curved tubes, glsl/svo_curve.glsl,
+// else capsules). Phase 0: atomicAdd(offsets[leaf], 1). Phase 1:
 // slot = atomicAdd(cursor[leaf], 1), and the segment index to
 // decoration[offsets[leaf] + 1 + slot] (slot below the list's length
 // offsets[leaf + 1] - offsets[leaf] - 1 only). One shader for both phases
@@ -56,14 +57,15 @@ struct SvoListsPush {
   uint segment_first;
   uint segment_count;
   float band;
-  uint curved;  // 1: curved tubes (glsl/svo_curve.glsl), 0: capsules
-  uint phase;   // 0: count, 1: fill
+  uint phase;  // 0: count, 1: fill
   uint pad0;
+  uint pad1;
 };
 
 // svo_list_sort.comp: invocation i < leaf_count: n = offsets[i + 1] -
 // offsets[i] - 1; decoration[offsets[i]] = n and the n indices after it
-// sorted ascending (insertion sort: lists are tens of words).
+// sorted ascending (in place: a shell sort, lists of a few to hundreds of
+// words).
 struct SvoListSortPush {
   uint64_t offsets;     // uint[leaf_count + 1], scanned
   uint64_t decoration;  // uint[]
@@ -109,7 +111,7 @@ SHADER_NAMESPACE_END
 #include <cstddef>
 static_assert(sizeof(fibscope::shader::SvoListsPush) == 96, "");
 static_assert(offsetof(fibscope::shader::SvoListsPush, origin_x) == 48, "");
-static_assert(offsetof(fibscope::shader::SvoListsPush, phase) == 88, "");
+static_assert(offsetof(fibscope::shader::SvoListsPush, phase) == 84, "");
 static_assert(sizeof(fibscope::shader::SvoListSortPush) == 32, "");
 static_assert(sizeof(fibscope::shader::SvoLevelPush) == 32, "");
 static_assert(sizeof(fibscope::shader::SvoNodesPush) == 48, "");

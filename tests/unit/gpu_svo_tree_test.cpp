@@ -207,7 +207,7 @@ TEST_F(GpuSvoTree, buildSvoGpuKeepsTheLeavesOnTheDeviceAndGivesTheSameTree) {
   expectSameTree(device, buildSvoTree(model, grid, leaves), model, leaves);
   expectSameTree(on_cpu, buildSvoTree(model, grid, leaves), model, leaves);
   EXPECT_GT(st.tree_s, 0.0);
-  EXPECT_GT(st.tree_times.lists_s, 0.0);
+  EXPECT_GT(st.tree_times.lists_s(), 0.0);
 }
 
 TEST_F(GpuSvoTree, noLeavesGiveAnEmptyRoot) {
@@ -270,11 +270,12 @@ TEST_F(GpuSvoTree, cpuAgainstGpuTreeStepWhenAsked) {
                                    });
       std::printf("%s: %zu segments, voxel %.3f mm, %u^3, %zu leaves, %zu references; voxelise %.1f s, sort %.1f s\n"
                   "  CPU buildSvoTree %.2f s (pairs %.2f, sort + lists %.2f, layout %.2f, lod %.2f)\n"
-                  "  GPU tree step    %.2f s (lists %.2f, levels + nodes %.2f, download %.2f, lod on CPU %.2f)\n"
+                  "  GPU tree step    %.2f s (lists: count %.2f, fill %.2f, sort %.2f; levels + nodes %.2f, download %.2f, "
+                  "lod on CPU %.2f)\n"
                   "  CPU / GPU %.2fx, trees %s\n",
                   path.c_str(), model.segments.size(), grid.voxel, grid.side(), cpu.leaves, cpu.references,
-                  st.voxelize_s, st.sort_s, cpu_s, ct.pairs_s, ct.sort_s, ct.layout_s, ct.lod_s, gpu_s, gt.lists_s,
-                  gt.levels_s, gt.download_s, gt.lod_s, cpu_s / gpu_s, same ? "identical" : "DIFFER");
+                  st.voxelize_s, st.sort_s, cpu_s, ct.pairs_s, ct.sort_s, ct.layout_s, ct.lod_s, gpu_s, gt.count_s,
+                  gt.fill_s, gt.sort_s, gt.levels_s, gt.download_s, gt.lod_s, cpu_s / gpu_s, same ? "identical" : "DIFFER");
       std::fflush(stdout);
       if (!same) expectSameTree(gpu, cpu, model, leaves);
     } catch (...) {

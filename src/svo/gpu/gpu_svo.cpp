@@ -385,9 +385,11 @@ std::string svoBuildSummary(const TubeModel& model, const SvoTree& tree, const S
                 stats.voxelize_s, stats.sort_s, stats.tree_s);
   std::string line = text;
   const SvoGpuTreeTimes& t = stats.tree_times;
-  if (t.lists_s > 0) {
-    std::snprintf(text, sizeof(text), " (on the device: lists %.3f s, levels and nodes %.3f s, download %.3f s; lod on "
-                  "the CPU %.3f s)", t.lists_s, t.levels_s, t.download_s, t.lod_s);
+  if (t.lists_s() > 0) {
+    std::snprintf(text, sizeof(text),
+                  " (on the device: lists %.3f s = count %.3f + fill %.3f + sort %.3f, levels and nodes %.3f s, "
+                  "download %.3f s; lod on the CPU %.3f s)",
+                  t.lists_s(), t.count_s, t.fill_s, t.sort_s, t.levels_s, t.download_s, t.lod_s);
     line += text;
   }
   return line;

@@ -52,11 +52,13 @@ struct SvoGpuBuildOptions {
 };
 
 // Wall time of the device's tree step (host clock; each part ends with a
-// wait for the device): the decoration lists (count, scan, fill, sort),
-// the levels and nodes, the download of nodes and lists, and the level of
-// detail (on the CPU, from the downloaded tree: svoLodFromTree).
+// wait for the device): the decoration lists (the count passes and the
+// offsets' scan, the fill passes, the per-leaf sort), the levels and
+// nodes, the download of nodes and lists, and the level of detail (on the
+// CPU, from the downloaded tree: svoLodFromTree).
 struct SvoGpuTreeTimes {
-  double lists_s = 0, levels_s = 0, download_s = 0, lod_s = 0;
+  double count_s = 0, fill_s = 0, sort_s = 0, levels_s = 0, download_s = 0, lod_s = 0;
+  double lists_s() const { return count_s + fill_s + sort_s; }
 };
 
 struct SvoGpuBuildStats {

@@ -36,10 +36,11 @@ constexpr uint32_t kListsBatchSegments = 1u << 18;
 
 struct TreePipelines {
   gpu::ComputePipeline lists, list_sort, levels, nodes;
-  explicit TreePipelines(const gpu::VulkanContext& c) : context(c) {
+  TreePipelines(const gpu::VulkanContext& c, bool curved) : context(c) {
     try {
+      const uint32_t lists_variant[] = {curved ? 1u : 0u};
       lists = gpu::createComputePipeline(c, "svo_lists.comp", sizeof(shader::SvoListsPush),
-                                         gpu::WorkgroupSize{shader::kSvoListsGroupSize});
+                                         gpu::WorkgroupSize{shader::kSvoListsGroupSize}, lists_variant);
       const gpu::WorkgroupSize tree_group{shader::kSvoTreeGroupSize};
       list_sort = gpu::createComputePipeline(c, "svo_list_sort.comp", sizeof(shader::SvoListSortPush), tree_group);
       levels = gpu::createComputePipeline(c, "svo_levels.comp", sizeof(shader::SvoLevelPush), tree_group);
@@ -120,7 +121,7 @@ SvoTree buildSvoTreeOnDevice(const gpu::VulkanContext& context, const TubeModel&
   const uint32_t segments = uint32_t(model.segments.size());
   const uint32_t batches = (segments + kListsBatchSegments - 1) / kListsBatchSegments;
   Progress progress("building", double(2 * batches + levels + 2), "steps", options.progress, options.progress_sink);
-  const TreePipelines p(context);
+  const TreePipelines p(context, grid.curved);
   auto start = std::chrono::steady_clock::now();
 
   // The lists: offsets[leaf] = 1 + its segments' count, scanned (exclusive)
@@ -139,7 +140,6 @@ SvoTree buildSvoTreeOnDevice(const gpu::VulkanContext& context, const TubeModel&
   lp.side = grid.side();
   lp.leaf_count = n;
   lp.band = grid.band();
-  lp.curved = grid.curved ? 1u : 0u;
   for (uint32_t batch = 0; batch < batches; ++batch) {
     const uint32_t first = batch * kListsBatchSegments;
     gpu::submitOnce(context, [&](VkCommandBuffer cmd) {
@@ -159,6 +159,8 @@ SvoTree buildSvoTreeOnDevice(const gpu::VulkanContext& context, const TubeModel&
     recordScan(context, cmd, radix, offsets.address, uint64_t(n) + 1, scratch.address);
   });
   const uint32_t words = downloadWord(context, offsets, n);
+  tt.count_s = secondsSince(start);
+  start = std::chrono::steady_clock::now();
   if (words > shader::kSvoNodeIndexMask)
     throw Error("svo: the decoration holds " + std::to_string(words) +
                 " words, more than the 2^30 a leaf reference reaches");
@@ -180,6 +182,8 @@ SvoTree buildSvoTreeOnDevice(const gpu::VulkanContext& context, const TubeModel&
     progress.add(1);
   }
   b.release(cursor);
+  tt.fill_s = secondsSince(start);
+  start = std::chrono::steady_clock::now();
   gpu::submitOnce(context, [&](VkCommandBuffer cmd) {
     gpu::computeToComputeBarrier(cmd);
     shader::SvoListSortPush sp{};
@@ -188,7 +192,7 @@ SvoTree buildSvoTreeOnDevice(const gpu::VulkanContext& context, const TubeModel&
     sp.leaf_count = n;
     recordSvoListSort(context, cmd, p.list_sort, sp);
   });
-  tt.lists_s = secondsSince(start);
+  tt.sort_s = secondsSince(start);
   start = std::chrono::steady_clock::now();
 
   // Levels bottom-up: count[l] nodes of level l, their slots in level l -
