@@ -29,16 +29,21 @@ layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer Se
 layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer CodesRef { uint codes[]; };
 layout(buffer_reference, std430, buffer_reference_align = 4) buffer WordsRef { uint words[]; };
 
-// The index of `code` among the sorted codes, or 0xFFFFFFFF.
-uint findLeaf(uint code) {
-  uint lo = 0u, hi = pc.leaf_count;
+// The first index in [lo, hi) whose code is not below `code`.
+uint lowerBound(uint code, uint lo, uint hi) {
   while (lo < hi) {
     const uint mid = (lo + hi) >> 1u;
     if (CodesRef(pc.codes).codes[mid] < code) lo = mid + 1u;
     else hi = mid;
   }
-  return lo < pc.leaf_count && CodesRef(pc.codes).codes[lo] == code ? lo : 0xFFFFFFFFu;
+  return lo;
 }
+
+// The codes of the segment's box: Morton codes grow with each coordinate,
+// so every voxel of the box has a code in [code(lo), code(hi)], a run of
+// the sorted leaves found once per workgroup; each voxel then searches
+// that run, not all the leaves.
+shared uint s_first, s_end;
 
 void main() {
   const uint g = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
@@ -57,7 +62,13 @@ void main() {
   const int side = int(pc.side);
   const ivec3 lo = max(ivec3(0), ivec3(floor((bmin - origin) / pc.voxel - 0.5)));
   const ivec3 hi = min(ivec3(side - 1), ivec3(ceil((bmax - origin) / pc.voxel - 0.5)));
-  if (any(greaterThan(lo, hi))) return;
+  if (any(greaterThan(lo, hi))) return;  // the whole workgroup: one segment
+  if (gl_LocalInvocationID.x == 0u) {
+    s_first = lowerBound(svoMorton(uint(lo.x), uint(lo.y), uint(lo.z)), 0u, pc.leaf_count);
+    s_end = lowerBound(svoMorton(uint(hi.x), uint(hi.y), uint(hi.z)) + 1u, s_first, pc.leaf_count);
+  }
+  barrier();
+  const uint first = s_first, end = s_end;
   const uvec3 n = uvec3(hi - lo + 1);
   const uint total = n.x * n.y * n.z;
   for (uint k = gl_LocalInvocationID.x; k < total; k += gl_WorkGroupSize.x) {
@@ -66,8 +77,9 @@ void main() {
     float u;
     const float f = kCurved ? svoCurveDistance(cv, p, u) : svoCapsuleDistance(c, p);
     if (!(abs(f) < pc.band)) continue;
-    const uint leaf = findLeaf(svoMorton(v.x, v.y, v.z));
-    if (leaf == 0xFFFFFFFFu) continue;
+    const uint code = svoMorton(v.x, v.y, v.z);
+    const uint leaf = lowerBound(code, first, end);
+    if (leaf == end || CodesRef(pc.codes).codes[leaf] != code) continue;  // inside another tube: no leaf
     if (pc.phase == 0u) {
       atomicAdd(WordsRef(pc.offsets).words[leaf], 1u);
       continue;
