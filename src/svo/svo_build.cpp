@@ -231,7 +231,12 @@ SvoMemoryNeed estimateSvoMemory(const TubeModel& model, const SvoGrid& grid, uin
   need.nodes = need.leaves * 8 * 8 / 7 + 8;
   need.decoration = (need.leaves + references) * 4;  // a count per leaf, an index per reference
   need.lists = uint64_t(model.segments.size()) * 2 * 4;
-  need.tree = (3 * need.leaves + 1) * 4 + need.nodes / 2;
+  // Slot words: one per node of levels 1 .. levels, level l holding at
+  // most min(leaves, 8^l) nodes (and each level's scan total word).
+  uint64_t slot_words = 0;
+  for (uint32_t lvl = 1; lvl <= grid.levels; ++lvl)
+    slot_words += std::min<uint64_t>(need.leaves, uint64_t(1) << std::min(3 * lvl, 62u)) + 1;
+  need.tree = (3 * need.leaves + 1 + slot_words) * 4;
   return need;
 }
 

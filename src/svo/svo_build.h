@@ -123,7 +123,8 @@ struct SvoMemoryNeed {
   uint64_t lists = 0;       // the slabs' segment lists (a segment in two slabs, as most are at most)
   // The device tree build's own buffers (gpu_svo_tree.cpp): per leaf its
   // list offset and fill cursor and a level's parent codes (at most one a
-  // node), and a slot word per node below the root (half the nodes' bytes).
+  // leaf), and a slot word per node below the root (level l at most
+  // min(leaves, 8^l) nodes).
   uint64_t tree = 0;
   uint64_t total() const { return field + sort + nodes + decoration + lists + tree; }
 };
