@@ -17,9 +17,8 @@
 #include "glsl/svo_curve.glsl"
 
 layout(local_size_x_id = WORKGROUP_SIZE_X_ID) in;  // kSvoListsGroupSize
-// Curved tubes (SvoGrid::curved) as a specialisation: a CPU device runs
-// both sides of a branch it cannot prove uniform, and the curved distance
-// costs some thirty capsule distances.
+// Curved tubes (SvoGrid::curved) as a specialisation, so the straight
+// variant carries none of the curved distance's code.
 layout(constant_id = 0) const bool kCurved = false;
 
 layout(push_constant, std430) uniform Push { SvoListsPush pc; };
