@@ -13,8 +13,10 @@
 # within the tolerance to come near them): A 241 tubes (3,530 segments),
 # B 1,701 (114,489), C 722 (30,948), D 10^5 fibers (the seed's largest
 # bundle, --scale full only). small: sets A and C, 6 frames sampled from
-# the orbit, for lavapipe. Writes OUT/<set>-<size>-<far|close>.json and
-# OUT/table.md. FRAMES, SAMPLE and METHODS override.
+# the orbit, for lavapipe; large: sets B and D, 2 frames sampled (on
+# lavapipe a frame of B takes tens of seconds, tessellated D hours: D
+# there without tess, METHODS_D). Writes OUT/<set>-<size>-<far|close>.json
+# and OUT/table.md. FRAMES, SAMPLE, METHODS and METHODS_D override.
 set -euo pipefail
 out=${1:?output folder}
 scale=${2:-full}
@@ -23,6 +25,7 @@ methods=${METHODS:-none,compute,raycast,tess}
 frames=${FRAMES:-500}
 sample=${SAMPLE:-0}
 [ "$scale" = small ] && sample=${SAMPLE:-6}
+[ "$scale" = large ] && sample=${SAMPLE:-2}
 mkdir -p "$out"
 "$fibscope" gpu-info > "$out/device.txt" 2>&1 || true
 # A method this binary does not have is dropped (bench would refuse it).
@@ -33,12 +36,15 @@ for m in "${want[@]}"; do
       -o "$out/.probe.png" >/dev/null 2>&1; then have+=("$m"); fi
 done
 methods=$(IFS=,; echo "${have[*]}")
+methods_d=${METHODS_D:-$methods}
+[ "$scale" = large ] && methods_d=${METHODS_D:-$(echo "$methods" | sed -e 's/,tess//' -e 's/^tess,//')}
 rm -f "$out/.probe.png"
 
 # name phantom-fibers tubes tolerance-mm radius-mm
 sets=("A 2000 0-240 0.2 0.5" "C 2000 0-721 0.05 0.3" "B 2000 0-1700 0.027 0.3")
 [ "$scale" = full ] && sets+=("D 100000 all 0.2 0.1")
 [ "$scale" = small ] && sets=("A 2000 0-240 0.2 0.5" "C 2000 0-721 0.05 0.3")
+[ "$scale" = large ] && sets=("B 2000 0-1700 0.027 0.3" "D 100000 all 0.2 0.1")
 sizes=(800x600 1200x768)
 for s in "${sets[@]}"; do
   read -r name fibers tubes tolerance radius <<<"$s"
@@ -47,9 +53,11 @@ for s in "${sets[@]}"; do
       distance=1
       [ "$view" = close ] && distance=0.3
       json="$out/$name-$size-$view.json"
-      echo "set $name ($tubes of $fibers fibers) $size $view: $methods" >&2
+      these=$methods
+      [ "$name" = D ] && these=$methods_d
+      echo "set $name ($tubes of $fibers fibers) $size $view: $these" >&2
       "$fibscope" bench --phantom-streamlines "$fibers" --tubes "$tubes" --tube-tolerance "$tolerance" \
-        --tube-radius "$radius" --tube-compare "$methods" --size "$size" --distance "$distance" \
+        --tube-radius "$radius" --tube-compare "$these" --size "$size" --distance "$distance" \
         --frames "$frames" --step "$(python3 -c "print(360 / $frames)")" --sample "$sample" --json > "$json"
     done
   done

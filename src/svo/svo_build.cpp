@@ -1,6 +1,7 @@
 #include "svo/svo_build.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <string>
 #include <unordered_map>
@@ -230,6 +231,12 @@ SvoMemoryNeed estimateSvoMemory(const TubeModel& model, const SvoGrid& grid, uin
   need.nodes = need.leaves * 8 * 8 / 7 + 8;
   need.decoration = (need.leaves + references) * 4;  // a count per leaf, an index per reference
   need.lists = uint64_t(model.segments.size()) * 2 * 4;
+  // Slot words: one per node of levels 1 .. levels, level l holding at
+  // most min(leaves, 8^l) nodes (and each level's scan total word).
+  uint64_t slot_words = 0;
+  for (uint32_t lvl = 1; lvl <= grid.levels; ++lvl)
+    slot_words += std::min<uint64_t>(need.leaves, uint64_t(1) << std::min(3 * lvl, 62u)) + 1;
+  need.tree = (3 * need.leaves + 1 + slot_words) * 4;
   return need;
 }
 
@@ -257,7 +264,18 @@ std::vector<SvoLeaf> voxelizeSvoLeaves(const TubeModel& model, const SvoGrid& gr
   return leaves;
 }
 
-SvoTree buildSvoTree(const TubeModel& model, const SvoGrid& grid, const std::vector<SvoLeaf>& leaves) {
+SvoTree buildSvoTree(const TubeModel& model, const SvoGrid& grid, const std::vector<SvoLeaf>& leaves,
+                     SvoTreeTimes* times) {
+  SvoTreeTimes local_times;
+  SvoTreeTimes& tt = times ? *times : local_times;
+  auto clock = std::chrono::steady_clock::now();
+  // Seconds since the last lap.
+  auto lap = [&clock]() {
+    const auto now = std::chrono::steady_clock::now();
+    const double s = std::chrono::duration<double>(now - clock).count();
+    clock = now;
+    return s;
+  };
   SvoTree tree;
   tree.grid = grid;
   tree.leaves = leaves.size();
@@ -282,6 +300,8 @@ SvoTree buildSvoTree(const TubeModel& model, const SvoGrid& grid, const std::vec
   for (uint32_t lvl = 1; lvl <= levels; ++lvl) base[lvl + 1] = base[lvl] + 8 * codes[lvl - 1].size();
   tree.nodes.assign(base[levels + 1], {shader::kSvoNodeEmpty, 0.0f});
 
+  tt.layout_s += lap();  // the levels' codes (the nodes' part of the layout)
+
   // Decoration lists: the (leaf, segment) pairs, by leaf.
   const float band = grid.band();
   std::vector<std::pair<uint32_t, uint32_t>> pairs;
@@ -300,6 +320,7 @@ SvoTree buildSvoTree(const TubeModel& model, const SvoGrid& grid, const std::vec
           pairs.emplace_back(uint32_t(it - codes[levels].begin()), si);
         }
   }
+  tt.pairs_s += lap();
   std::sort(pairs.begin(), pairs.end());
   tree.decoration.reserve(leaves.size() + pairs.size());
   tree.references = pairs.size();
@@ -317,6 +338,7 @@ SvoTree buildSvoTree(const TubeModel& model, const SvoGrid& grid, const std::vec
   if (tree.decoration.size() > shader::kSvoNodeIndexMask)
     throw Error("svo: the decoration holds " + std::to_string(tree.decoration.size()) +
                 " words, more than the 2^30 a leaf reference reaches");
+  tt.sort_s += lap();
 
   // Every node of level l (rank j among them) sits at slot (code & 7) of
   // its parent's block (the parent's rank p among level l - 1).
@@ -335,6 +357,7 @@ SvoTree buildSvoTree(const TubeModel& model, const SvoGrid& grid, const std::vec
         tree.nodes[index] = {shader::kSvoNodeLeaf | list_offset[j], leaves[j].distance};
     }
   }
+  tt.layout_s += lap();
 
   // Level of detail: the (node rank, segment, references) of each level,
   // from the leaves' (leaf, segment) pairs merged upward level by level
@@ -385,6 +408,7 @@ SvoTree buildSvoTree(const TubeModel& model, const SvoGrid& grid, const std::vec
     }
     entries.resize(out);
   }
+  tt.lod_s += lap();
   return tree;
 }
 

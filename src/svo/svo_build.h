@@ -121,7 +121,12 @@ struct SvoMemoryNeed {
   uint64_t nodes = 0;       // tree, about 8/7 of the leaves' blocks
   uint64_t decoration = 0;  // count + indices per leaf
   uint64_t lists = 0;       // the slabs' segment lists (a segment in two slabs, as most are at most)
-  uint64_t total() const { return field + sort + nodes + decoration + lists; }
+  // The device tree build's own buffers (gpu_svo_tree.cpp): per leaf its
+  // list offset and fill cursor and a level's parent codes (at most one a
+  // leaf), and a slot word per node below the root (level l at most
+  // min(leaves, 8^l) nodes).
+  uint64_t tree = 0;
+  uint64_t total() const { return field + sort + nodes + decoration + lists + tree; }
 };
 // `slab_depth` voxels of z per slab of the dense field.
 SvoMemoryNeed estimateSvoMemory(const TubeModel& model, const SvoGrid& grid, uint32_t slab_depth);
@@ -152,6 +157,13 @@ struct SvoTree {
   size_t lodBytes() const { return lod.size() * sizeof(uint32_t); }
 };
 
+// Wall time of buildSvoTree's parts: the (leaf, segment) pairs (the
+// distance at every voxel of every segment's box), their sort and the
+// lists, the node layout, the level of detail.
+struct SvoTreeTimes {
+  double pairs_s = 0, sort_s = 0, layout_s = 0, lod_s = 0;
+};
+
 // CPU reference of the voxelisation: the leaves (|f| < band) in Morton
 // order. Cost O(sum of segment box voxels); memory O(grid side^3 / 8)
 // at most (a hash of the band voxels).
@@ -165,7 +177,22 @@ std::vector<SvoLeaf> voxelizeSvoLeaves(const TubeModel& model, const SvoGrid& gr
 // parent's), laid out top-down: root, then the level-1 block, then each
 // level's blocks in code order; `lod` from the same lists. Throws Error
 // when the decoration exceeds 2^30 words.
-SvoTree buildSvoTree(const TubeModel& model, const SvoGrid& grid, const std::vector<SvoLeaf>& leaves);
+SvoTree buildSvoTree(const TubeModel& model, const SvoGrid& grid, const std::vector<SvoLeaf>& leaves,
+                     SvoTreeTimes* times = nullptr);
+
+// SvoTree::lod from the tree itself (its nodes and decoration lists, the
+// leaves at level `levels`), as buildSvoTree defines it: the level
+// structure read off the node layout (level l + 1's blocks follow level
+// l's, one per internal node in order), each internal node's
+// most-referenced segment by merging its children's (segment, count) runs
+// level by level upward. For the GPU build, whose lists are on the host
+// only after their download. Cost O(references * levels * log).
+std::vector<uint32_t> svoLodFromTree(const std::vector<shader::SvoNode>& nodes,
+                                     const std::vector<uint32_t>& decoration, uint32_t levels);
+
+// tree.leaves_over_4, max_segments_per_leaf and references from its
+// decoration (tree.leaves lists, one after the other).
+void svoCountListStats(SvoTree& tree);
 
 // voxelizeSvoLeaves then buildSvoTree.
 SvoTree buildSvoCpu(const TubeModel& model, const SvoGrid& grid);

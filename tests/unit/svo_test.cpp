@@ -68,6 +68,11 @@ TEST(SvoMemoryEstimate, boundsTheBuildAndTheDensityCriterionFitsTheLimit) {
     EXPECT_GE(need.references, tree.references);
     EXPECT_GE(need.nodes, tree.nodeBytes());
     EXPECT_GE(need.decoration, tree.decorationBytes());
+    // The device tree build's own buffers: offsets, cursors and a level's
+    // parent codes per leaf, a slot word per node below the root.
+    size_t below_root = 0;
+    for (size_t i = 1; i < tree.nodes.size(); ++i) below_root += tree.nodes[i].ref != shader::kSvoNodeEmpty;
+    EXPECT_GE(need.tree, (3 * tree.leaves + 1 + below_root + grid.levels) * 4);
     EXPECT_LT(need.leaves, need.references);
   }
   // A limit below the rule's voxel's need: the chosen voxel is coarser, by

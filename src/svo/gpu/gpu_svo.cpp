@@ -17,6 +17,7 @@
 #include "gpu/submit.h"
 #include "render/gpu/frame_stages.h"
 #include "shared/svo.h"
+#include "svo/gpu/svo_gpu_detail.h"
 
 namespace fibscope {
 namespace {
@@ -31,72 +32,15 @@ std::string megabytes(uint64_t bytes) {
   return text;
 }
 
-// The sort's three pipelines.
-struct RadixPipelines {
-  gpu::ComputePipeline histogram, scan, scan_add, scatter;
-  explicit RadixPipelines(const gpu::VulkanContext& c) : context(c) {
-    try {
-      histogram = gpu::createComputePipeline(c, "radix_histogram.comp", sizeof(shader::RadixPush));
-      scan = gpu::createComputePipeline(c, "radix_scan.comp", sizeof(shader::RadixScanPush));
-      scan_add = gpu::createComputePipeline(c, "radix_scan_add.comp", sizeof(shader::RadixScanPush));
-      scatter = gpu::createComputePipeline(c, "radix_scatter.comp", sizeof(shader::RadixPush));
-    } catch (...) {
-      destroy();
-      throw;
-    }
-  }
-  ~RadixPipelines() { destroy(); }
-  void destroy() {
-    gpu::destroyComputePipeline(context, scatter);
-    gpu::destroyComputePipeline(context, scan_add);
-    gpu::destroyComputePipeline(context, scan);
-    gpu::destroyComputePipeline(context, histogram);
-  }
-  const gpu::VulkanContext& context;
-};
-
-// Owns buffers made in one function, released in reverse order.
-struct Buffers {
-  explicit Buffers(const gpu::VulkanContext& c) : context(c) {}
-  ~Buffers() {
-    for (auto it = list.rbegin(); it != list.rend(); ++it) gpu::destroyBuffer(context, *it);
-  }
-  gpu::Buffer& make(VkDeviceSize bytes, gpu::MemoryUse use) {
-    return list.emplace_back(gpu::createBuffer(context, std::max<VkDeviceSize>(bytes, 4), use));
-  }
-  void release(gpu::Buffer& b) { gpu::destroyBuffer(context, b); }
-  const gpu::VulkanContext& context;
-  std::deque<gpu::Buffer> list;
-};
+using svo_gpu::Buffers;
+using svo_gpu::RadixPipelines;
 
 // Words of the sort's counts buffer for `count` keys: the digit-major
 // counts, then each level's chunk totals of the scan above them.
 uint64_t radixCountsWords(uint64_t count) {
   const uint64_t blocks = (count + shader::kRadixBlock - 1) / shader::kRadixBlock;
-  uint64_t n = blocks * shader::kRadixDigits, words = n;
-  while (n > 1) {
-    n = (n + shader::kRadixScanChunk - 1) / shader::kRadixScanChunk;
-    words += n;
-  }
-  return words + 1;
-}
-
-// The exclusive scan of the n words at `data` in place, the chunks' totals
-// at `scratch` (and the levels above after them).
-void recordScan(const gpu::VulkanContext& context, VkCommandBuffer cmd, const RadixPipelines& p, VkDeviceAddress data,
-                uint64_t n, VkDeviceAddress scratch) {
-  const uint64_t chunks = (n + shader::kRadixScanChunk - 1) / shader::kRadixScanChunk;
-  const gpu::DispatchGrid grid = gpu::dispatchGrid(context, chunks);
-  shader::RadixScanPush push{};
-  push.data = data;
-  push.sums = scratch;
-  push.count = uint32_t(n);
-  gpu::recordDispatch(cmd, p.scan, push, grid.x, grid.y);
-  gpu::computeToComputeBarrier(cmd);
-  if (chunks <= 1) return;  // one chunk: scanned whole
-  recordScan(context, cmd, p, scratch, chunks, scratch + chunks * 4);
-  gpu::recordDispatch(cmd, p.scan_add, push, grid.x, grid.y);
-  gpu::computeToComputeBarrier(cmd);
+  const uint64_t n = blocks * shader::kRadixDigits;
+  return n + svo_gpu::scanScratchWords(n) + 1;
 }
 
 // Records the sort of `count` pairs in (keys, values), using (keys2,
@@ -125,7 +69,7 @@ void recordRadixSort(const gpu::VulkanContext& context, VkCommandBuffer cmd, con
     gpu::recordDispatch(cmd, p.histogram, push, grid.x, grid.y);
     gpu::computeToComputeBarrier(cmd);
     const uint64_t n = uint64_t(blocks) * shader::kRadixDigits;
-    recordScan(context, cmd, p, counts.address, n, counts.address + n * 4);
+    svo_gpu::recordScan(context, cmd, p, counts.address, n, counts.address + n * 4);
     gpu::recordDispatch(cmd, p.scatter, push, grid.x, grid.y);
     gpu::computeToComputeBarrier(cmd);
   }
@@ -170,6 +114,35 @@ SlabLists slabSegmentLists(const TubeModel& model, const SvoGrid& grid, uint32_t
 constexpr uint64_t kVoxelizeBatchSegments = uint64_t(1) << 20;
 
 }  // namespace
+
+namespace svo_gpu {
+
+uint64_t scanScratchWords(uint64_t n) {
+  uint64_t words = 0;
+  while (n > 1) {
+    n = (n + shader::kRadixScanChunk - 1) / shader::kRadixScanChunk;
+    words += n;
+  }
+  return words;
+}
+
+void recordScan(const gpu::VulkanContext& context, VkCommandBuffer cmd, const RadixPipelines& p, VkDeviceAddress data,
+                uint64_t n, VkDeviceAddress scratch) {
+  const uint64_t chunks = (n + shader::kRadixScanChunk - 1) / shader::kRadixScanChunk;
+  const gpu::DispatchGrid grid = gpu::dispatchGrid(context, chunks);
+  shader::RadixScanPush push{};
+  push.data = data;
+  push.sums = scratch;
+  push.count = uint32_t(n);
+  gpu::recordDispatch(cmd, p.scan, push, grid.x, grid.y);
+  gpu::computeToComputeBarrier(cmd);
+  if (chunks <= 1) return;  // one chunk: scanned whole
+  recordScan(context, cmd, p, scratch, chunks, scratch + chunks * 4);
+  gpu::recordDispatch(cmd, p.scan_add, push, grid.x, grid.y);
+  gpu::computeToComputeBarrier(cmd);
+}
+
+}  // namespace svo_gpu
 
 uint64_t svoMemoryLimit(const gpu::VulkanContext& context, const SvoGpuBuildOptions& options) {
   if (options.memory_limit_bytes) return options.memory_limit_bytes;
@@ -218,11 +191,13 @@ void recordSvoVoxelize(const gpu::VulkanContext& context, VkCommandBuffer cmd, c
   gpu::recordDispatch(cmd, voxelize, push, g.x, g.y);
 }
 
-std::vector<SvoLeaf> voxelizeSvoLeavesGpu(const gpu::VulkanContext& context, const TubeModel& model,
-                                          const GpuTubes& tubes, const SvoGrid& grid,
-                                          const SvoGpuBuildOptions& options, SvoGpuBuildStats* stats) {
-  SvoGpuBuildStats local;
-  SvoGpuBuildStats& st = stats ? *stats : local;
+namespace {
+
+// The leaves voxelised and sorted, left on the device in buffers of `b`
+// (the dense slab released before it returns).
+svo_gpu::DeviceLeaves voxelizeToDevice(const gpu::VulkanContext& context, const TubeModel& model,
+                                       const GpuTubes& tubes, const SvoGrid& grid, const SvoGpuBuildOptions& options,
+                                       SvoGpuBuildStats& st, const RadixPipelines& radix, Buffers& b) {
   const uint64_t side = grid.side();
   const uint32_t slab_depth = svoSlabDepth(grid, options.field_budget_bytes);
   st.slab_depth = slab_depth;
@@ -233,12 +208,12 @@ std::vector<SvoLeaf> voxelizeSvoLeavesGpu(const gpu::VulkanContext& context, con
     throw Error("svo: the octree of " + std::to_string(model.segments.size()) + " segments at a voxel of " +
                 std::to_string(grid.voxel) + " mm needs about " + megabytes(st.need.total()) + " (distance slab " +
                 megabytes(st.need.field) + ", leaves " + megabytes(st.need.sort) + ", nodes " +
-                megabytes(st.need.nodes) + ", decoration " + megabytes(st.need.decoration) +
+                megabytes(st.need.nodes) + ", decoration " + megabytes(st.need.decoration) + ", tree build " +
+                megabytes(st.need.tree) +
                 "), more than the device's " + megabytes(limit) + ": choose a larger voxel");
   if (tubes.segment_count == 0) return {};
 
   gpu::ComputePipeline voxelize, compact;
-  std::unique_ptr<RadixPipelines> radix;
   struct Pipes {
     const gpu::VulkanContext& c;
     gpu::ComputePipeline& a;
@@ -251,9 +226,7 @@ std::vector<SvoLeaf> voxelizeSvoLeavesGpu(const gpu::VulkanContext& context, con
   voxelize = createSvoVoxelizePipeline(context);
   compact = gpu::createComputePipeline(context, "svo_compact.comp", sizeof(shader::SvoCompactPush),
                                        gpu::WorkgroupSize{shader::kSvoCompactGroupSize});
-  radix = std::make_unique<RadixPipelines>(context);
 
-  Buffers b(context);
   gpu::Buffer& field = b.make(side * side * slab_depth * 4, gpu::MemoryUse::DeviceLocal);
   gpu::Buffer& count_buffer = b.make(4, gpu::MemoryUse::DeviceLocal);
   uint64_t capacity = std::max<uint64_t>(st.need.leaves, 1024);
@@ -322,7 +295,7 @@ std::vector<SvoLeaf> voxelizeSvoLeavesGpu(const gpu::VulkanContext& context, con
     if (count <= capacity) {
       st.voxelize_s = secondsSince(start);
       start = std::chrono::steady_clock::now();
-      std::vector<SvoLeaf> leaves(count);
+      b.release(field);
       if (count > 0) {
         Progress sorting("sorting", 1, "sorts", options.progress, options.progress_sink);
         gpu::Buffer& keys2 = b.make(VkDeviceSize(count) * 4, gpu::MemoryUse::DeviceLocal);
@@ -330,17 +303,17 @@ std::vector<SvoLeaf> voxelizeSvoLeavesGpu(const gpu::VulkanContext& context, con
         gpu::Buffer& counts = b.make(VkDeviceSize(radixCountsWords(count)) * 4, gpu::MemoryUse::DeviceLocal);
         gpu::submitOnce(context, [&](VkCommandBuffer cmd) {
           gpu::computeToComputeBarrier(cmd);  // the compaction's writes (earlier submissions)
-          recordRadixSort(context, cmd, *radix, keys, values, keys2, values2, counts, count, 3 * grid.levels);
+          recordRadixSort(context, cmd, radix, keys, values, keys2, values2, counts, count, 3 * grid.levels);
         });
-        std::vector<uint32_t> k(count), v(count);
-        gpu::downloadFromBuffer(context, keys, k.data(), size_t(count) * 4);
-        gpu::downloadFromBuffer(context, values, v.data(), size_t(count) * 4);
-        for (uint32_t i = 0; i < count; ++i) leaves[i] = {k[i], shader::uintBitsToFloat(v[i])};
         sorting.add(1);
         sorting.finish();
+        // The sort's scratch is not needed by the tree build.
+        b.release(counts);
+        b.release(values2);
+        b.release(keys2);
       }
       st.sort_s = secondsSince(start);
-      return leaves;
+      return {&keys, &values, count};
     }
     // The estimate was short: again with the exact count.
     ++st.retries;
@@ -350,16 +323,53 @@ std::vector<SvoLeaf> voxelizeSvoLeavesGpu(const gpu::VulkanContext& context, con
   }
 }
 
+}  // namespace
+
+std::vector<SvoLeaf> voxelizeSvoLeavesGpu(const gpu::VulkanContext& context, const TubeModel& model,
+                                          const GpuTubes& tubes, const SvoGrid& grid,
+                                          const SvoGpuBuildOptions& options, SvoGpuBuildStats* stats) {
+  SvoGpuBuildStats local;
+  SvoGpuBuildStats& st = stats ? *stats : local;
+  const RadixPipelines radix(context);
+  Buffers b(context);
+  const svo_gpu::DeviceLeaves d = voxelizeToDevice(context, model, tubes, grid, options, st, radix, b);
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<SvoLeaf> leaves(d.count);
+  if (d.count > 0) {
+    std::vector<uint32_t> k(d.count), v(d.count);
+    gpu::downloadFromBuffer(context, *d.codes, k.data(), size_t(d.count) * 4);
+    gpu::downloadFromBuffer(context, *d.distances, v.data(), size_t(d.count) * 4);
+    for (uint32_t i = 0; i < d.count; ++i) leaves[i] = {k[i], shader::uintBitsToFloat(v[i])};
+  }
+  st.sort_s += secondsSince(start);
+  return leaves;
+}
+
 SvoTree buildSvoGpu(const gpu::VulkanContext& context, const TubeModel& model, const GpuTubes& tubes,
                     const SvoGrid& grid, const SvoGpuBuildOptions& options, SvoGpuBuildStats* stats) {
   SvoGpuBuildStats local;
   SvoGpuBuildStats& st = stats ? *stats : local;
-  const std::vector<SvoLeaf> leaves = voxelizeSvoLeavesGpu(context, model, tubes, grid, options, &st);
+  const RadixPipelines radix(context);
+  Buffers b(context);
+  const svo_gpu::DeviceLeaves d = voxelizeToDevice(context, model, tubes, grid, options, st, radix, b);
   const auto start = std::chrono::steady_clock::now();
-  Progress building("building", 1, "trees", options.progress, options.progress_sink);
-  SvoTree tree = buildSvoTree(model, grid, leaves);
-  building.add(1);
-  building.finish();
+  SvoTree tree;
+  if (options.tree_on_cpu.value_or(context.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU)) {
+    // The CPU reference from the same leaves (downloaded).
+    std::vector<SvoLeaf> leaves(d.count);
+    if (d.count > 0) {
+      std::vector<uint32_t> k(d.count), v(d.count);
+      gpu::downloadFromBuffer(context, *d.codes, k.data(), size_t(d.count) * 4);
+      gpu::downloadFromBuffer(context, *d.distances, v.data(), size_t(d.count) * 4);
+      for (uint32_t i = 0; i < d.count; ++i) leaves[i] = {k[i], shader::uintBitsToFloat(v[i])};
+    }
+    Progress building("building", 1, "trees", options.progress, options.progress_sink);
+    tree = buildSvoTree(model, grid, leaves, &st.cpu_tree_times);
+    building.add(1);
+    building.finish();
+  } else {
+    tree = svo_gpu::buildSvoTreeOnDevice(context, model, tubes, grid, d, radix, b, options, &st.tree_times);
+  }
   st.tree_s = secondsSince(start);
   return tree;
 }
@@ -374,7 +384,16 @@ std::string svoBuildSummary(const TubeModel& model, const SvoTree& tree, const S
                 stats.slabs, tree.leaves, tree.leaves_over_4, tree.max_segments_per_leaf,
                 double(tree.nodeBytes()) / 1e6, double(tree.decorationBytes()) / 1e6, double(tree.lodBytes()) / 1e6,
                 stats.voxelize_s, stats.sort_s, stats.tree_s);
-  return text;
+  std::string line = text;
+  const SvoGpuTreeTimes& t = stats.tree_times;
+  if (t.lists_s() > 0) {
+    std::snprintf(text, sizeof(text),
+                  " (on the device: lists %.3f s = count %.3f + fill %.3f + sort %.3f, levels and nodes %.3f s, "
+                  "download %.3f s; lod on the CPU %.3f s)",
+                  t.lists_s(), t.count_s, t.fill_s, t.sort_s, t.levels_s, t.download_s, t.lod_s);
+    line += text;
+  }
+  return line;
 }
 
 GpuSvo uploadSvo(const gpu::VulkanContext& context, const SvoTree& tree) {

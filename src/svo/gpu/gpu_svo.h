@@ -1,8 +1,8 @@
 // SVO streamtubes on the device (issue 16): the GPU radix sort, the GPU
 // voxelisation (svo_voxelize.comp, svo_compact.comp: slab by slab, so the
 // dense distance field never exceeds a budget), the build that uses them
-// (leaves from the GPU, the tree and its decoration lists by
-// buildSvoTree, the same function the CPU reference uses), the octree's
+// (leaves from the GPU, the tree and its decoration lists on the GPU too,
+// shared/svo_build.h, to buildSvoTree's layout and values), the octree's
 // upload and the ray-tracing frame stage (svo_trace.comp).
 #pragma once
 
@@ -46,9 +46,25 @@ struct SvoGpuBuildOptions {
   uint64_t memory_limit_bytes = 0;
   bool progress = false;  // progress lines on stderr (voxelising, sorting, building)
   Progress::Sink progress_sink;  // the same reports to a progress bar (the viewer's), when set
+  // The tree, lists and level of detail by buildSvoTree on the CPU from
+  // the downloaded leaves (the reference, and the benchmarks' side by
+  // side) instead of on the device. Unset: on the CPU where the device is
+  // a CPU (lavapipe runs the device step 4-5x slower than the compiled
+  // buildSvoTree: docs/BENCHMARKS.md), on the device elsewhere.
+  std::optional<bool> tree_on_cpu;
   // Not null: the build throws Error ("cancelled") at the next slab once it
   // holds true (the viewer quitting during a build).
   const std::atomic<bool>* cancel = nullptr;
+};
+
+// Wall time of the device's tree step (host clock; each part ends with a
+// wait for the device): the decoration lists (the count passes and the
+// offsets' scan, the fill passes, the per-leaf sort), the levels and
+// nodes, the download of nodes and lists, and the level of detail (on the
+// CPU, from the downloaded tree: svoLodFromTree).
+struct SvoGpuTreeTimes {
+  double count_s = 0, fill_s = 0, sort_s = 0, levels_s = 0, download_s = 0, lod_s = 0;
+  double lists_s() const { return count_s + fill_s + sort_s; }
 };
 
 struct SvoGpuBuildStats {
@@ -56,6 +72,8 @@ struct SvoGpuBuildStats {
   uint32_t slab_depth = 0;
   uint32_t retries = 0;  // reruns after the leaf buffer's estimate proved short
   double voxelize_s = 0, sort_s = 0, tree_s = 0;  // wall time (host clock around each step)
+  SvoGpuTreeTimes tree_times;   // tree_s's parts on the device
+  SvoTreeTimes cpu_tree_times;  // tree_s's parts with tree_on_cpu
   SvoMemoryNeed need;
 };
 
@@ -70,10 +88,23 @@ std::vector<SvoLeaf> voxelizeSvoLeavesGpu(const gpu::VulkanContext& context, con
                                           const GpuTubes& tubes, const SvoGrid& grid,
                                           const SvoGpuBuildOptions& options = {}, SvoGpuBuildStats* stats = nullptr);
 
-// voxelizeSvoLeavesGpu then buildSvoTree. Throws Error naming the size
-// needed when the estimate exceeds the memory limit.
+// voxelizeSvoLeavesGpu, then the tree, its decoration lists (from the
+// sorted leaves left on the device) and its nodes built on the device
+// (shared/svo_build.h) and downloaded, the level of detail on the CPU
+// from them: the SvoTree buildSvoTree makes of the same leaves (or
+// buildSvoTree itself where options.tree_on_cpu). Throws Error naming the
+// size needed when the estimate exceeds the memory limit, or when the
+// decoration exceeds 2^30 words.
 SvoTree buildSvoGpu(const gpu::VulkanContext& context, const TubeModel& model, const GpuTubes& tubes,
                     const SvoGrid& grid, const SvoGpuBuildOptions& options = {}, SvoGpuBuildStats* stats = nullptr);
+
+// The device's tree step alone from `leaves` (sorted by code, codes
+// unique), uploaded: the tree, lists and level of detail buildSvoGpu makes
+// after its voxelisation, for tests and for timing it beside buildSvoTree
+// on the same leaves. Throws Error as buildSvoTree does.
+SvoTree buildSvoTreeGpu(const gpu::VulkanContext& context, const TubeModel& model, const GpuTubes& tubes,
+                        const SvoGrid& grid, const std::vector<SvoLeaf>& leaves,
+                        const SvoGpuBuildOptions& options = {}, SvoGpuTreeTimes* times = nullptr);
 
 // One line for the command line: segments, streamline buffer, grid,
 // leaves (and those over 4 segments), nodes and decoration MB, the level
