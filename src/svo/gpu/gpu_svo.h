@@ -52,7 +52,8 @@ struct SvoGpuBuildOptions {
   // a CPU (lavapipe runs the device step 4-5x slower than the compiled
   // buildSvoTree: docs/BENCHMARKS.md), on the device elsewhere.
   std::optional<bool> tree_on_cpu;
-  // Not null: the build throws Error ("cancelled") at the next slab once it
+  // Not null: the build throws Error ("cancelled") at the next slab (or
+  // batch of the device tree step's lists) once it
   // holds true (the viewer quitting during a build).
   const std::atomic<bool>* cancel = nullptr;
 };

@@ -141,6 +141,7 @@ SvoTree buildSvoTreeOnDevice(const gpu::VulkanContext& context, const TubeModel&
   lp.leaf_count = n;
   lp.band = grid.band();
   for (uint32_t batch = 0; batch < batches; ++batch) {
+    if (options.cancel && options.cancel->load()) throw Error("svo: the build was cancelled");
     const uint32_t first = batch * kListsBatchSegments;
     gpu::submitOnce(context, [&](VkCommandBuffer cmd) {
       // The sort's writes and the previous batch's counts (earlier
@@ -170,6 +171,7 @@ SvoTree buildSvoTreeOnDevice(const gpu::VulkanContext& context, const TubeModel&
   lp.cursor = cursor.address;
   lp.decoration = decoration.address;
   for (uint32_t batch = 0; batch < batches; ++batch) {
+    if (options.cancel && options.cancel->load()) throw Error("svo: the build was cancelled");
     const uint32_t first = batch * kListsBatchSegments;
     gpu::submitOnce(context, [&](VkCommandBuffer cmd) {
       gpu::computeToComputeBarrier(cmd);  // the scan's offsets, the previous batch's cursors
