@@ -365,10 +365,7 @@ SvoTree buildSvoTree(const TubeModel& model, const SvoGrid& grid, const std::vec
   // node's representative is its most referenced segment. Cost
   // O(references * levels * log); the lists shrink upward as children
   // share segments.
-  struct LodEntry {
-    uint32_t rank, segment, count;
-  };
-  std::vector<LodEntry> entries;
+  std::vector<SvoLodEntry> entries;
   entries.reserve(pairs.size());
   for (const auto& [leaf, segment] : pairs) entries.push_back({leaf, segment, 1});
   tree.lod.assign((tree.nodes.size() - 1) / 8, 0);
@@ -381,32 +378,12 @@ SvoTree buildSvoTree(const TubeModel& model, const SvoGrid& grid, const std::vec
       while (up[p] != (here[j] >> 3)) ++p;
       parent[j] = uint32_t(p);
     }
-    for (LodEntry& e : entries) e.rank = parent[e.rank];
+    for (SvoLodEntry& e : entries) e.rank = parent[e.rank];
     // Ranks stay in order (the parent's rank grows with the child's); sort
     // each parent's run by segment and add up equal segments. A node whose
     // lists are all empty (a leaf at the band's float edge) keeps segment 0.
-    size_t out = 0;
-    for (size_t i = 0; i < entries.size();) {
-      const uint32_t rank = entries[i].rank;
-      size_t end = i;
-      while (end < entries.size() && entries[end].rank == rank) ++end;
-      std::sort(entries.begin() + ptrdiff_t(i), entries.begin() + ptrdiff_t(end),
-                [](const LodEntry& a, const LodEntry& b) { return a.segment < b.segment; });
-      uint32_t best = entries[i].segment, best_count = 0;
-      for (size_t k = i; k < end;) {
-        LodEntry merged = entries[k];
-        for (++k; k < end && entries[k].segment == merged.segment; ++k) merged.count += entries[k].count;
-        if (merged.count > best_count) {
-          best_count = merged.count;
-          best = merged.segment;
-        }
-        entries[out++] = merged;
-      }
-      // Node `rank` of level lvl - 1 owns the block at base[lvl] + 8 rank.
-      tree.lod[(base[lvl] + 8 * size_t(rank) - 1) / 8] = best;
-      i = end;
-    }
-    entries.resize(out);
+    // Node `rank` of level lvl - 1 owns the block at base[lvl] + 8 rank.
+    mergeSvoLodLevel(entries, tree.lod, [&](uint32_t rank) { return (base[lvl] + 8 * size_t(rank) - 1) / 8; });
   }
   tt.lod_s += lap();
   return tree;

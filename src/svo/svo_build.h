@@ -10,6 +10,7 @@
 // same tree from the same leaves.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -190,6 +191,17 @@ SvoTree buildSvoTree(const TubeModel& model, const SvoGrid& grid, const std::vec
 std::vector<uint32_t> svoLodFromTree(const std::vector<shader::SvoNode>& nodes,
                                      const std::vector<uint32_t>& decoration, uint32_t levels);
 
+// One level of the level of detail's upward merge (buildSvoTree,
+// svoLodFromTree): `entries` (node rank, segment, references), in runs of
+// equal rank in rank order; each run sorted by segment, equal segments
+// added up (entries shrinks to the merged ones), and `lod[slot(rank)]` set
+// to the run's most referenced segment (ties: the smaller index).
+struct SvoLodEntry {
+  uint32_t rank, segment, count;
+};
+template <typename Slot>
+void mergeSvoLodLevel(std::vector<SvoLodEntry>& entries, std::vector<uint32_t>& lod, Slot slot);
+
 // tree.leaves_over_4, max_segments_per_leaf and references from its
 // decoration (tree.leaves lists, one after the other).
 void svoCountListStats(SvoTree& tree);
@@ -202,5 +214,30 @@ SvoTree buildSvoCpu(const TubeModel& model, const SvoGrid& grid);
 // zero-length segment is its sphere). False when it misses.
 bool intersectCapsule(const glm::dvec3& a, const glm::dvec3& b, double r, const glm::dvec3& o, const glm::dvec3& d,
                       double t_min, double& t);
+
+template <typename Slot>
+void mergeSvoLodLevel(std::vector<SvoLodEntry>& entries, std::vector<uint32_t>& lod, Slot slot) {
+  size_t out = 0;
+  for (size_t i = 0; i < entries.size();) {
+    const uint32_t rank = entries[i].rank;
+    size_t end = i;
+    while (end < entries.size() && entries[end].rank == rank) ++end;
+    std::sort(entries.begin() + ptrdiff_t(i), entries.begin() + ptrdiff_t(end),
+              [](const SvoLodEntry& a, const SvoLodEntry& b) { return a.segment < b.segment; });
+    uint32_t best = entries[i].segment, best_count = 0;
+    for (size_t k = i; k < end;) {
+      SvoLodEntry merged = entries[k];
+      for (++k; k < end && entries[k].segment == merged.segment; ++k) merged.count += entries[k].count;
+      if (merged.count > best_count) {
+        best_count = merged.count;
+        best = merged.segment;
+      }
+      entries[out++] = merged;
+    }
+    lod[slot(rank)] = best;
+    i = end;
+  }
+  entries.resize(out);
+}
 
 }  // namespace fibscope

@@ -30,10 +30,7 @@ std::vector<uint32_t> svoLodFromTree(const std::vector<shader::SvoNode>& nodes,
   if (begin[levels + 1] != nodes.size())
     throw Error("svo: the tree's levels hold " + std::to_string(begin[levels + 1]) + " nodes, not its " +
                 std::to_string(nodes.size()));
-  struct LodEntry {
-    uint32_t rank, segment, count;  // rank: of the parent among its level's internal nodes
-  };
-  std::vector<LodEntry> entries;
+  std::vector<SvoLodEntry> entries;  // rank: of the parent among its level's internal nodes
   for (size_t i = begin[levels]; i < begin[levels + 1]; ++i) {
     if (!isType(nodes[i], shader::kSvoNodeLeaf)) continue;
     const uint32_t at = nodes[i].ref & shader::kSvoNodeIndexMask;
@@ -47,35 +44,15 @@ std::vector<uint32_t> svoLodFromTree(const std::vector<shader::SvoNode>& nodes,
     // rank among level lvl - 1's internal nodes (in order). Each parent's
     // run sorted by segment, equal segments added up, the most referenced
     // kept (ties: the smaller index, the first in the run).
-    size_t out = 0;
-    for (size_t i = 0; i < entries.size();) {
-      const uint32_t rank = entries[i].rank;
-      size_t end = i;
-      while (end < entries.size() && entries[end].rank == rank) ++end;
-      std::sort(entries.begin() + ptrdiff_t(i), entries.begin() + ptrdiff_t(end),
-                [](const LodEntry& a, const LodEntry& b) { return a.segment < b.segment; });
-      uint32_t best = entries[i].segment, best_count = 0;
-      for (size_t k = i; k < end;) {
-        LodEntry merged = entries[k];
-        for (++k; k < end && entries[k].segment == merged.segment; ++k) merged.count += entries[k].count;
-        if (merged.count > best_count) {
-          best_count = merged.count;
-          best = merged.segment;
-        }
-        entries[out++] = merged;
-      }
-      // Internal node `rank` of level lvl - 1 owns the block at begin[lvl] + 8 rank.
-      lod[(begin[lvl] + 8 * size_t(rank) - 1) / 8] = best;
-      i = end;
-    }
-    entries.resize(out);
+    // Internal node `rank` of level lvl - 1 owns the block at begin[lvl] + 8 rank.
+    mergeSvoLodLevel(entries, lod, [&](uint32_t rank) { return (begin[lvl] + 8 * size_t(rank) - 1) / 8; });
     if (lvl == 1) break;
     // Internal node p of level lvl - 1 (the p-th in order) sits in block
     // (slot - begin[lvl - 1]) / 8 of its level: its parent's rank.
     parent.clear();
     for (size_t i = begin[lvl - 1]; i < begin[lvl]; ++i)
       if (isType(nodes[i], shader::kSvoNodeInternal)) parent.push_back(uint32_t((i - begin[lvl - 1]) / 8));
-    for (LodEntry& e : entries) e.rank = parent[e.rank];
+    for (SvoLodEntry& e : entries) e.rank = parent[e.rank];
   }
   return lod;
 }

@@ -323,6 +323,17 @@ svo_gpu::DeviceLeaves voxelizeToDevice(const gpu::VulkanContext& context, const 
   }
 }
 
+// The sorted leaves the voxelisation left on the device, downloaded.
+std::vector<SvoLeaf> downloadLeaves(const gpu::VulkanContext& context, const svo_gpu::DeviceLeaves& d) {
+  std::vector<SvoLeaf> leaves(d.count);
+  if (d.count == 0) return leaves;
+  std::vector<uint32_t> k(d.count), v(d.count);
+  gpu::downloadFromBuffer(context, *d.codes, k.data(), size_t(d.count) * 4);
+  gpu::downloadFromBuffer(context, *d.distances, v.data(), size_t(d.count) * 4);
+  for (uint32_t i = 0; i < d.count; ++i) leaves[i] = {k[i], shader::uintBitsToFloat(v[i])};
+  return leaves;
+}
+
 }  // namespace
 
 std::vector<SvoLeaf> voxelizeSvoLeavesGpu(const gpu::VulkanContext& context, const TubeModel& model,
@@ -334,13 +345,7 @@ std::vector<SvoLeaf> voxelizeSvoLeavesGpu(const gpu::VulkanContext& context, con
   Buffers b(context);
   const svo_gpu::DeviceLeaves d = voxelizeToDevice(context, model, tubes, grid, options, st, radix, b);
   const auto start = std::chrono::steady_clock::now();
-  std::vector<SvoLeaf> leaves(d.count);
-  if (d.count > 0) {
-    std::vector<uint32_t> k(d.count), v(d.count);
-    gpu::downloadFromBuffer(context, *d.codes, k.data(), size_t(d.count) * 4);
-    gpu::downloadFromBuffer(context, *d.distances, v.data(), size_t(d.count) * 4);
-    for (uint32_t i = 0; i < d.count; ++i) leaves[i] = {k[i], shader::uintBitsToFloat(v[i])};
-  }
+  std::vector<SvoLeaf> leaves = downloadLeaves(context, d);
   st.sort_s += secondsSince(start);
   return leaves;
 }
@@ -356,13 +361,7 @@ SvoTree buildSvoGpu(const gpu::VulkanContext& context, const TubeModel& model, c
   SvoTree tree;
   if (options.tree_on_cpu.value_or(context.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU)) {
     // The CPU reference from the same leaves (downloaded).
-    std::vector<SvoLeaf> leaves(d.count);
-    if (d.count > 0) {
-      std::vector<uint32_t> k(d.count), v(d.count);
-      gpu::downloadFromBuffer(context, *d.codes, k.data(), size_t(d.count) * 4);
-      gpu::downloadFromBuffer(context, *d.distances, v.data(), size_t(d.count) * 4);
-      for (uint32_t i = 0; i < d.count; ++i) leaves[i] = {k[i], shader::uintBitsToFloat(v[i])};
-    }
+    const std::vector<SvoLeaf> leaves = downloadLeaves(context, d);
     Progress building("building", 1, "trees", options.progress, options.progress_sink);
     tree = buildSvoTree(model, grid, leaves, &st.cpu_tree_times);
     building.add(1);
