@@ -13,8 +13,9 @@ case "$mode" in run|test) ;; *) echo "usage: $0 run|test" >&2; exit 2 ;; esac
 packages=(g++ cmake ninja-build pkg-config libgtest-dev libbenchmark-dev libcli11-dev
           nlohmann-json3-dev libzip-dev zlib1g-dev libglm-dev libtinyobjloader-dev libnifti2-dev)
 # Vulkan: loader and headers, the shader compiler, lavapipe (Vulkan on the CPU
-# where there is no GPU) and the validation layers (on in every GPU test).
-packages+=(libvulkan-dev glslc mesa-vulkan-drivers vulkan-validationlayers)
+# where there is no GPU) and the validation layers (on in every GPU test);
+# spirv-val checks the task and mesh shaders lavapipe cannot run.
+packages+=(libvulkan-dev glslc spirv-tools mesa-vulkan-drivers vulkan-validationlayers)
 # The viewer's window and panels (GLFW, Dear ImGui with its backend sources),
 # and a virtual X display for it where there is no screen.
 packages+=(libglfw3-dev libimgui-dev xvfb xauth)
