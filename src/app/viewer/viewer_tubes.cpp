@@ -85,6 +85,20 @@ double secondsSince(std::chrono::steady_clock::time_point t) {
 
 }  // namespace
 
+void ViewerTubes::Shared::report(const ProgressSnapshot& s) {
+  std::lock_guard lock(mutex);
+  progress = s;
+}
+
+void ViewerTubes::Shared::throwIfCancelled() const {
+  if (cancel) throw Error("tubes: the build was cancelled");
+}
+
+void ViewerTubes::Shared::phase(const char* label) {
+  throwIfCancelled();
+  report(ProgressSnapshot{label});
+}
+
 ViewerTubes::ViewerTubes(const gpu::VulkanContext& context, std::string device_name,
                          std::shared_ptr<gpu::DebugLog> validation_log, std::string cache_dir)
     : context_(context),
@@ -119,13 +133,6 @@ void ViewerTubes::clear() {
 std::shared_ptr<const ViewerTubes::ModelPart> ViewerTubes::buildModel(const Job& job) {
   const ModelOptions& o = job.options;
   const bool svo = job.request.svo != TubesInfo::Svo::None;
-  const auto cancelled = [shared = shared_]() {
-    if (shared->cancel) throw Error("tubes: the build was cancelled");
-  };
-  const auto report = [shared = shared_](const ProgressSnapshot& s) {
-    std::lock_guard lock(shared->mutex);
-    shared->progress = s;
-  };
   auto part = std::make_shared<ModelPart>();
   const auto t0 = std::chrono::steady_clock::now();
   Tractogram fibers;
@@ -133,7 +140,7 @@ std::shared_ptr<const ViewerTubes::ModelPart> ViewerTubes::buildModel(const Job&
   size_t total = 0;
   for (const ViewerTubeSource& source : job.sources) total += source.fibers.size();
   {
-    Progress decoding("decoding fibers", double(total), "fibers", false, report);
+    Progress decoding("decoding fibers", double(total), "fibers", false, progressSink());
     for (const ViewerTubeSource& source : job.sources) {
       if (source.fibers.empty()) continue;
       if (!source.fbl) throw Error("tubes: a model's .fbl is not in reach");
@@ -141,7 +148,7 @@ std::shared_ptr<const ViewerTubes::ModelPart> ViewerTubes::buildModel(const Job&
       // In chunks of ~1 M points, each appended once (no whole copy).
       size_t next = 0;
       decodeFibers(*source.fbl, source.fibers, size_t(1) << 20, [&](const Tractogram& chunk) {
-        cancelled();
+        shared_->throwIfCancelled();
         for (size_t i = 0; i < chunk.streamlineCount(); ++i, ++next) {
           fibers.addStreamline(chunk.point(chunk.offsets[i]), chunk.pointsIn(i));
           scene_ids.push_back(source.fiber_base + source.fibers[next]);
@@ -152,7 +159,7 @@ std::shared_ptr<const ViewerTubes::ModelPart> ViewerTubes::buildModel(const Job&
     }
     decoding.finish();
   }
-  cancelled();
+  shared_->throwIfCancelled();
   TubeBuildOptions options;
   options.radius.radius = o.radius_mm;
   // The octree from the fibers' own points, as render's --pipeline svo-*.
@@ -164,7 +171,7 @@ std::shared_ptr<const ViewerTubes::ModelPart> ViewerTubes::buildModel(const Job&
                           : "from " + o.radius_from + " " + std::to_string(r.radius_min) + "," +
                                 std::to_string(r.radius_max) + " data " + std::to_string(r.data_min) + "," +
                                 std::to_string(r.data_max);
-  report(ProgressSnapshot{"tube model"});
+  shared_->phase("tube model");
   part->model = buildTubes(fibers, options, &part->stats);
   // buildTubes numbers fibers by their index in `fibers` (the octree's
   // lists index segments, not fibers: the tree does not depend on the
@@ -179,20 +186,12 @@ void ViewerTubes::buildOnDevice(const Job& job, Built& b) {
   const ViewerTubeRequest& r = job.request;
   const TubeModel& model = b.model->model;
   const bool svo = r.svo != TubesInfo::Svo::None && !b.svo_kept;
-  const auto report = [shared = shared_](const ProgressSnapshot& s) {
-    std::lock_guard lock(shared->mutex);
-    shared->progress = s;
-  };
-  const auto phase = [&](const char* label) {
-    if (shared_->cancel) throw Error("tubes: the build was cancelled");
-    report(ProgressSnapshot{label});
-  };
   std::optional<SvoCacheKey> svo_key;
   if (svo && cache_.enabled())
     svo_key = svoCacheKey(b.model->model_texts, b.model->radius_text, 0.0f, r.voxel_mm,
                           r.svo == TubesInfo::Svo::Curved);
   if (svo && svo_key) {
-    phase("reading the octree cache");
+    shared_->phase("reading the octree cache");
     const auto t0 = std::chrono::steady_clock::now();
     b.tree = cache_.lookup(*svo_key, b.warnings, model.segments.size());
     if (b.tree) {
@@ -202,7 +201,7 @@ void ViewerTubes::buildOnDevice(const Job& job, Built& b) {
     }
   }
   if (!worker_context_) {
-    phase("starting the device");
+    shared_->phase("starting the device");
     gpu::ContextOptions options;
     options.device_name = device_name_;
     options.instance.validation = validation_log_ != nullptr;
@@ -214,7 +213,7 @@ void ViewerTubes::buildOnDevice(const Job& job, Built& b) {
   try {
     if (svo && !b.tree) {
       SvoGpuBuildOptions options;
-      options.progress_sink = report;
+      options.progress_sink = progressSink();
       options.cancel = &shared_->cancel;
       // A voxel from the data is coarsened until the octree fits the device.
       const SvoGrid grid =
@@ -223,12 +222,12 @@ void ViewerTubes::buildOnDevice(const Job& job, Built& b) {
       b.tree = buildSvoGpu(context, model, tubes, grid, options, &b.svo_stats);
       b.svo_seconds = secondsSince(t0);
       if (svo_key) {
-        phase("writing the octree cache");
+        shared_->phase("writing the octree cache");
         cache_.store(*svo_key, *b.tree, b.warnings);
       }
     }
     if (r.distance_field) {
-      phase("distance field");
+      shared_->phase("distance field");
       b.field_grid = chooseDistanceFieldGrid(model, r.df_voxel_mm);
       GpuDistanceField field = buildDistanceFieldGpu(context, tubes, b.field_grid);
       b.field_seconds = field.build_s;

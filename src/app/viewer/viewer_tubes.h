@@ -135,7 +135,16 @@ class ViewerTubes {
     std::mutex mutex;
     std::optional<ProgressSnapshot> progress;
     std::atomic<bool> cancel{false};  // the destructor's: the worker stops at its next step
+    void report(const ProgressSnapshot& s);
+    // Throws Error once `cancel` holds (the worker's steps call it).
+    void throwIfCancelled() const;
+    // A step without a count: `label` reported, after throwIfCancelled.
+    void phase(const char* label);
   };
+  // Reports to shared_ (a progress bar's sink for the builds' Progress).
+  Progress::Sink progressSink() const {
+    return [shared = shared_](const ProgressSnapshot& s) { shared->report(s); };
+  }
   // The job's tube model: its fibers decoded and built (on the worker).
   std::shared_ptr<const ModelPart> buildModel(const Job& job);
   void start(Job job);
