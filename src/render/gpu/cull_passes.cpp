@@ -399,4 +399,11 @@ CullStats readCullStats(const gpu::VulkanContext& context, const CullBuffers& bu
   return stats;
 }
 
+void checkFibletLinePipeline(RenderPipeline kind, const RenderSettings& settings, bool has_fiblets) {
+  if (!has_fiblets) throw Error("render: the " + std::string(renderPipelineName(kind)) + " pipeline needs fiblets");
+  if (settings.culling == CullingMode::Coverage)
+    throw Error("render: coverage culling is the compute pipeline's; the " + std::string(renderPipelineName(kind)) +
+                " pipeline takes none, frustum or two-phase");
+}
+
 }  // namespace fibscope

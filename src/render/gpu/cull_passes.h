@@ -181,6 +181,12 @@ void markCullHistory(CullBuffers& buffers, const SceneLayout& scene, uint32_t ph
 // readCullStats (phase 2: into the second phase's slots).
 void recordCullListStats(VkCommandBuffer cmd, const CullBuffers& buffers, uint32_t phase = 0);
 
+// The checks of a pipeline that draws fiblets as hardware lines (geometry,
+// tessellation, mesh, mesh-serial): it needs fiblets (`has_fiblets`), and
+// takes culling none, frustum or two-phase (the coverage buffer re-projects
+// the compute pipeline's visibility keys). Throws Error naming `kind`.
+void checkFibletLinePipeline(RenderPipeline kind, const RenderSettings& settings, bool has_fiblets);
+
 // The fiblets drawn by the last recorded frame (summed over its datasets),
 // once it has completed.
 struct CullStats {

@@ -43,12 +43,7 @@ class FibletGraphicsStage final : public FrameStage {
   }
 
   void check(const FrameContext& frame) const override {
-    if (frame.scene.datasets.empty())
-      throw Error("render: the " + std::string(renderPipelineName(kind_)) + " pipeline needs fiblets");
-    // The coverage buffer re-projects the compute pipeline's visibility keys.
-    if (frame.settings.culling == CullingMode::Coverage)
-      throw Error("render: coverage culling is the compute pipeline's; the " +
-                  std::string(renderPipelineName(kind_)) + " pipeline takes none, frustum or two-phase");
+    checkFibletLinePipeline(kind_, frame.settings, !frame.scene.datasets.empty());
   }
 
   void record(FrameContext& frame) override {

@@ -49,11 +49,7 @@ class FibletMeshStage final : public FrameStage {
 
   void check(const FrameContext& frame) const override {
     if (const std::string why = fibletMeshRefusal(frame.context, kind_); !why.empty()) throw Error(why);
-    if (frame.scene.datasets.empty())
-      throw Error("render: the " + std::string(renderPipelineName(kind_)) + " pipeline needs fiblets");
-    if (frame.settings.culling == CullingMode::Coverage)
-      throw Error("render: coverage culling is the compute pipeline's; the " +
-                  std::string(renderPipelineName(kind_)) + " pipeline takes none, frustum or two-phase");
+    checkFibletLinePipeline(kind_, frame.settings, !frame.scene.datasets.empty());
   }
 
   void record(FrameContext& frame) override {
