@@ -1,7 +1,7 @@
 // Spline tubes, compute ray casting, pass 2 (shared/tubes.h
 // TubeRaycastPush): one workgroup per screen tile, one invocation per
-// pixel. The tile's sub-segments (its list from tube_bin.comp, or every
-// sub-segment where the list overflowed) are loaded a workgroup's worth at
+// pixel. The tile's sub-segments (its list from the binning passes, or
+// every sub-segment where the list ended past the buffer) are loaded a workgroup's worth at
 // a time into shared memory as quadratics with their boxes; each pixel's
 // eye ray is tested against the boxes and then intersected
 // (glsl/tube_intersect.glsl), the nearest front hit kept against the
@@ -28,6 +28,7 @@ layout(push_constant, std430) uniform Push { TubeRaycastPush pc; };
 layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer NodesRef { TubeNode nodes[]; };
 layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer SegmentsRef { TubeSegment segments[]; };
 layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer CountsRef { uint counts[]; };
+layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer EndsRef { uint ends[]; };
 layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer ListsRef { uint items[]; };
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer SurfaceRef { SurfaceTexel texels[]; };
 
@@ -51,14 +52,16 @@ void main() {
   uint best_item = 0xFFFFFFFFu;
   float best_t = 0.0, best_s = 0.0;
 
-  const uint count = CountsRef(pc.tile_counts).counts[tile.y * pc.tiles_x + tile.x];
-  const bool overflow = count > kTubeTileCapacity;
-  const uint total = overflow ? pc.sub_segments : count;
+  const uint tile_index = tile.y * pc.tiles_x + tile.x;
+  const uint count = CountsRef(pc.tile_counts).counts[tile_index];
+  const uint end = EndsRef(pc.tile_ends).ends[tile_index];
+  const bool overflow = count > 0u && end > pc.list_capacity;
+  const uint total = overflow ? pc.sub_segments : count, start = end - count;
   for (uint base = 0u; base < total; base += kBatch) {
     barrier();
     const uint k = base + local;
     if (k < total) {
-      const uint item = overflow ? k : ListsRef(pc.tile_lists).items[(tile.y * pc.tiles_x + tile.x) * kTubeTileCapacity + k];
+      const uint item = overflow ? k : ListsRef(pc.tile_lists).items[start + k];
       const TubeSegment s = SegmentsRef(pc.segments).segments[item / 2u];
       const TubeQuadratic q =
           tubeQuadratic(NodesRef(pc.nodes).nodes[s.node], NodesRef(pc.nodes).nodes[s.node + 1u], s.chord, item % 2u);
@@ -73,7 +76,14 @@ void main() {
     if (!inside) continue;
     const uint n = min(kBatch, total - base);
     for (uint j = 0u; j < n; ++j) {
-      if (!tubeRayHitsBox(s_lo[j], s_hi[j], o, inv_d)) continue;
+      float enter;
+      if (!tubeRayEntersBox(s_lo[j], s_hi[j], o, inv_d, enter)) continue;
+      // A box the ray enters behind the nearest surface so far (a tube hit
+      // or what other stages left) holds no nearer hit: skip its
+      // intersection, the cost of a pixel. The margin (16 ulps of depth 1)
+      // keeps every candidate that float rounding could still let win.
+      const vec4 ce = cameraTransformPoint(cam.view_projection, o + enter * d);
+      if (ce.w > 0.0 && ce.z / ce.w > best_depth + 1e-6) continue;
       float s, t;
       if (!tubeIntersect(s_quads[j], o, d, s, t)) continue;
       const vec4 c = cameraTransformPoint(cam.view_projection, o + s * d);

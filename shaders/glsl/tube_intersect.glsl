@@ -165,11 +165,13 @@ void tubeBox(TubeQuadratic q, out vec3 lo, out vec3 hi) {
   hi += vec3(r);
 }
 
-// Whether the ray o + s d (s > 0) meets the box.
-bool tubeRayHitsBox(vec3 lo, vec3 hi, vec3 o, vec3 inv_d) {
+// Whether the ray o + s d (s > 0) meets the box; `enter`: the s at which
+// it enters (0 from inside).
+bool tubeRayEntersBox(vec3 lo, vec3 hi, vec3 o, vec3 inv_d, out float enter) {
   const vec3 t0 = (lo - o) * inv_d, t1 = (hi - o) * inv_d;
   const vec3 tn = min(t0, t1), tf = max(t0, t1);
-  const float enter = max(max(tn.x, tn.y), max(tn.z, 0.0)), leave = min(min(tf.x, tf.y), tf.z);
+  enter = max(max(tn.x, tn.y), max(tn.z, 0.0));
+  const float leave = min(min(tf.x, tf.y), tf.z);
   return enter <= leave;
 }
 

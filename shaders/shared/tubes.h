@@ -27,15 +27,22 @@
 SHADER_NAMESPACE_BEGIN
 
 // Screen tiles of the compute ray caster (kTubeTileSize^2 pixels, one
-// workgroup each) and the sub-segments a tile's list holds (2 KiB a tile:
-// 66 MB of lists at 1920 x 1080); a tile whose count exceeds it tests every
-// sub-segment instead (slow, never wrong), and is counted
-// (FrameStats::tube_tiles_overflowed). A thin tube crosses a number of
-// sub-segments per tile proportional to the tile's side, which every pixel
-// of the tile then tests: 8 px tiles cast 300 phantom tubes (22,620
-// segments, 800 x 600, lavapipe) in 2.4 s against 4.8 s with 16 px tiles.
+// workgroup each). A thin tube crosses a number of sub-segments per tile
+// proportional to the tile's side, which every pixel of the tile then
+// tests: 8 px tiles cast 300 phantom tubes (22,620 segments, 800 x 600,
+// lavapipe) in 2.4 s against 4.8 s with 16 px tiles.
+//
+// The tiles' lists are packed end to end in one buffer (counted, scanned,
+// filled: tube_bin_count, tube_bin_offsets, tube_bin_fill), so a tile holds
+// as many sub-segments as reach it. The buffer starts at
+// kTubeTileCapacity items a tile and grows to the frame's total for the
+// next frame, up to a byte limit; a tile whose list ends past the buffer
+// tests every sub-segment instead (slow, never wrong) and is counted
+// (FrameStats::tube_tiles_overflowed).
 TUBE_CONST uint kTubeTileSize = 8u;
 TUBE_CONST uint kTubeTileCapacity = 512u;
+// Invocations of the offsets pass (one workgroup over every tile).
+TUBE_CONST uint kTubeScanGroupSize = 256u;
 // Sub-segments per workgroup of the binning pass.
 TUBE_CONST uint kTubeBinGroupSize = 64u;
 // The colour slope of a node (TubeNode::color_slope) is stored as
@@ -103,25 +110,41 @@ SHADER_FN TubeQuadratic tubeQuadratic(TubeNode a, TubeNode b, float chord, uint 
   return out_q;
 }
 
-// tube_bin.comp: one invocation per sub-segment: its box (the quadratic's
-// exact extent per axis, widened by its largest radius control) projected
-// to the screen, and the sub-segment appended to the list of every tile
-// the projection overlaps (tile_counts[tile] counts past the capacity).
+// tube_bin_count.comp and tube_bin_fill.comp: one invocation per
+// sub-segment: its box (the quadratic's exact extent per axis, widened by
+// its largest radius control) projected to the screen (glsl/tube_bin.glsl);
+// the count pass adds one to every tile the projection overlaps, the fill
+// pass appends the sub-segment to those tiles' lists (tile_ends[tile], the
+// list's start after the offsets pass, is its cursor and ends as the list's
+// end).
 struct TubeBinPush {
   uint64_t camera;       // CameraBlock
   uint64_t nodes;        // TubeNode[]
   uint64_t segments;     // TubeSegment[]
-  uint64_t tile_counts;  // uint per tile, then the count of overflowing tiles; cleared to 0 before the pass
-  uint64_t tile_lists;   // uint[tiles * kTubeTileCapacity]: sub-segment indices
+  uint64_t tile_counts;  // uint per tile, then the overflowing tiles, then the total; cleared to 0 before the count
+  uint64_t tile_ends;    // uint per tile: written by the offsets pass, advanced by the fill
+  uint64_t tile_lists;   // uint[list_capacity]: sub-segment indices, tile after tile
   uint sub_segments;     // 2 * segments
   uint tiles_x;
   uint tiles_y;
-  uint pad0;
+  uint list_capacity;    // items the lists buffer holds
+};
+
+// tube_bin_offsets.comp: one workgroup of kTubeScanGroupSize: the exclusive
+// prefix sum of the tiles' counts into tile_ends (each list's start), the
+// total into tile_counts[tiles + 1] and the number of tiles whose list ends
+// past list_capacity into tile_counts[tiles].
+struct TubeBinOffsetsPush {
+  uint64_t tile_counts;
+  uint64_t tile_ends;
+  uint tiles;
+  uint list_capacity;
 };
 
 // tube_raycast.comp: one invocation per pixel, workgroups of one tile: the
 // eye ray through the pixel centre against every sub-segment of its tile's
-// list (or all of them where the list overflowed), the front intersection
+// list (tile_ends[tile] - tile_counts[tile] to tile_ends[tile]; all of them
+// where the list ends past list_capacity), the front intersection
 // of the sphere-swept model (tubeIntersect in glsl/tube_intersect.glsl;
 // its CPU reference src/tubes/tube_intersect.h), kept where its clip depth
 // lies in [0, 1] and is nearer than the surface texel's.
@@ -130,12 +153,15 @@ struct TubeRaycastPush {
   uint64_t nodes;
   uint64_t segments;
   uint64_t tile_counts;
+  uint64_t tile_ends;
   uint64_t tile_lists;
   uint64_t surface;  // SurfaceTexel per pixel (read and written)
   uint sub_segments;
   uint tiles_x;
   uint width;
   uint height;
+  uint list_capacity;
+  uint pad0;
 };
 
 SHADER_NAMESPACE_END
@@ -146,10 +172,11 @@ static_assert(sizeof(fibscope::shader::TubeNode) == 48, "a tube node is 12 words
 static_assert(offsetof(fibscope::shader::TubeNode, color) == 32, "");
 static_assert(sizeof(fibscope::shader::TubeSegment) == 16, "a tube segment is 4 words");
 static_assert(sizeof(fibscope::shader::TubeQuadratic) == 48, "");
-static_assert(sizeof(fibscope::shader::TubeBinPush) == 56, "");
-static_assert(offsetof(fibscope::shader::TubeBinPush, sub_segments) == 40, "");
-static_assert(sizeof(fibscope::shader::TubeRaycastPush) == 64, "");
-static_assert(offsetof(fibscope::shader::TubeRaycastPush, sub_segments) == 48, "");
+static_assert(sizeof(fibscope::shader::TubeBinPush) == 64, "");
+static_assert(offsetof(fibscope::shader::TubeBinPush, sub_segments) == 48, "");
+static_assert(sizeof(fibscope::shader::TubeBinOffsetsPush) == 24, "");
+static_assert(sizeof(fibscope::shader::TubeRaycastPush) == 80, "");
+static_assert(offsetof(fibscope::shader::TubeRaycastPush, sub_segments) == 56, "");
 #endif
 
 #endif  // FIBSCOPE_SHADERS_SHARED_TUBES_H

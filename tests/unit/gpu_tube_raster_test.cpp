@@ -13,6 +13,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -36,7 +37,10 @@
 namespace fibscope {
 namespace {
 
-using StageMaker = FrameStageFactory (*)(const GpuTubes*);
+using StageMaker = std::function<FrameStageFactory(const GpuTubes*)>;
+
+// The compute caster with its default lists.
+FrameStageFactory computeCaster(const GpuTubes* tubes) { return tubeRaycastStage(tubes); }
 
 class GpuTubeRaster : public test::GpuTest {
  protected:
@@ -186,7 +190,7 @@ TEST_F(GpuTubeRaster, fragmentAndComputeVariantsWriteTheSameTexelsOnCurvedTubes)
     const TubeModel model = buildTubes(scene.tractogram, scene.options);
     for (const Camera& camera : test::tubeSceneCameras(scene, 120, 90)) {
       const Identity id =
-          compareVariants(cast(model, camera, tubeRasterRaycastStage), cast(model, camera, tubeRaycastStage));
+          compareVariants(cast(model, camera, tubeRasterRaycastStage), cast(model, camera, computeCaster));
       expectSameTexels(id, scene.name + " " + cameraName(camera));
     }
   }
@@ -206,7 +210,7 @@ TEST_F(GpuTubeRaster, fragmentAndComputeVariantsWriteTheSameTexelsOnAOnePointSph
   camera.near_mm = 20;
   camera.far_mm = 40;
   const std::vector<shader::SurfaceTexel> raster = cast(model, camera, tubeRasterRaycastStage);
-  expectSameTexels(compareVariants(raster, cast(model, camera, tubeRaycastStage)), "one-point sphere");
+  expectSameTexels(compareVariants(raster, cast(model, camera, computeCaster)), "one-point sphere");
   const Agreement a =
       compareWithReference(raster, renderReferenceTubes(model, camera, TubeReferenceMethod::Cascade), camera);
   EXPECT_NEAR(double(a.both), 194.0, 20.0) << a.summary();  // a disk of radius 7.9 px
@@ -221,7 +225,7 @@ TEST_F(GpuTubeRaster, theTubeStageSwitchesMethodsFrameToFrameAsTheirOwnStagesDra
   const test::TubeScene scene = test::tubeScenes().front();  // a copy: tubeScenes() returns by value
   const TubeModel model = buildTubes(scene.tractogram, scene.options);
   const Camera camera = test::tubeSceneCameras(scene, 96, 72).front();
-  const std::vector<shader::SurfaceTexel> compute = cast(model, camera, tubeRaycastStage);
+  const std::vector<shader::SurfaceTexel> compute = cast(model, camera, computeCaster);
   const std::vector<shader::SurfaceTexel> raster = cast(model, camera, tubeRasterRaycastStage);
   GpuTubes tubes = uploadTubes(context(), model);
   try {
@@ -270,9 +274,9 @@ TEST_F(GpuTubeRaster, theTubeStageSwitchesMethodsFrameToFrameAsTheirOwnStagesDra
   destroyTubes(context(), tubes);
 }
 
-// 300 short tubes piled in the same few tiles (the compute test's scene):
-// over kTubeTileCapacity sub-segments a tile, where the compute caster
-// tests every sub-segment; the boxes need no lists.
+// 300 short tubes piled in the same few tiles (the compute test's scene),
+// the compute caster's lists held to 64 items, so its tiles overflow and
+// test every sub-segment; the boxes need no lists.
 TEST_F(GpuTubeRaster, fragmentAndComputeVariantsAgreeWhereTileListsOverflow) {
   Tractogram t;
   for (int i = 0; i < 300; ++i) {
@@ -284,10 +288,13 @@ TEST_F(GpuTubeRaster, fragmentAndComputeVariantsAgreeWhereTileListsOverflow) {
   TubeBuildOptions o;
   o.radius.radius = 0.1f;
   const TubeModel model = buildTubes(t, o);
-  ASSERT_GT(model.subSegmentCount(), size_t(shader::kTubeTileCapacity));
+  ASSERT_GT(model.subSegmentCount(), size_t(64));
   const Camera camera = fitCamera(tractogramBounds(t), {0.2, -0.3, 1}, {0, 1, 0}, 48, 48);
   FrameStats compute_stats;
-  const std::vector<shader::SurfaceTexel> compute = cast(model, camera, tubeRaycastStage, &compute_stats);
+  const auto small_lists = [](const GpuTubes* tubes) {
+    return tubeRaycastStage(tubes, TubeRaycastOptions{64 * sizeof(uint32_t)});
+  };
+  const std::vector<shader::SurfaceTexel> compute = cast(model, camera, small_lists, &compute_stats);
   ASSERT_GT(compute_stats.tube_tiles_overflowed, 0u);
   const std::vector<shader::SurfaceTexel> raster = cast(model, camera, tubeRasterRaycastStage);
   expectSameTexels(compareVariants(raster, compute), "overflowing tiles");
@@ -345,7 +352,7 @@ TEST_F(GpuTubeRaster, benchComputeAgainstFragmentVariant) {
   GpuTubes tubes = uploadTubes(context(), model);
   std::vector<shader::SurfaceTexel> images[2];
   try {
-    const StageMaker makers[2] = {tubeRaycastStage, tubeRasterRaycastStage};
+    const StageMaker makers[2] = {computeCaster, tubeRasterRaycastStage};
     const char* names[2] = {"compute", "fragment"};
     for (int v = 0; v < 2; ++v) {
       FrameRenderer renderer(context(), camera.width, camera.height, {makeSetupStage, makers[v](&tubes)});

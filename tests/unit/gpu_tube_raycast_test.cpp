@@ -1,4 +1,4 @@
-// The compute ray casting of spline tubes (src/tubes/gpu, tube_bin.comp,
+// The compute ray casting of spline tubes (src/tubes/gpu, tube_bin_*.comp,
 // tube_raycast.comp) against the CPU reference of the same intersection
 // (src/tubes/tube_intersect.h, itself tested against the brute-force sphere
 // sweep): hit/miss, depth, fiber, normal and position along the fiber per
@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -36,14 +37,24 @@ class GpuTubeRaycast : public test::GpuTest {
   // only).
   std::vector<shader::SurfaceTexel> castOnGpu(const TubeModel& model, const Camera& camera,
                                               FrameStats* stats = nullptr) {
+    return castFrames(model, camera, {}, 1, stats).back();
+  }
+  // The surface targets of `frames` frames of `model` by one renderer, and
+  // each frame's statistics.
+  std::vector<std::vector<shader::SurfaceTexel>> castFrames(const TubeModel& model, const Camera& camera,
+                                                            TubeRaycastOptions options, int frames,
+                                                            FrameStats* stats) {
     GpuTubes tubes = uploadTubes(context(), model);
-    std::vector<shader::SurfaceTexel> surface;
+    std::vector<std::vector<shader::SurfaceTexel>> surface;
     try {
       // The compute pipeline's frame over no datasets: no geometry stage.
-      FrameRenderer renderer(context(), camera.width, camera.height, {makeSetupStage, tubeRaycastStage(&tubes)});
-      const FrameStats frame = renderer.render(camera, RenderSettings(), GpuScene());
-      if (stats) *stats = frame;
-      surface = downloadSurface(context(), renderer.targets());
+      FrameRenderer renderer(context(), camera.width, camera.height,
+                             {makeSetupStage, tubeRaycastStage(&tubes, options)});
+      for (int f = 0; f < frames; ++f) {
+        const FrameStats frame = renderer.render(camera, RenderSettings(), GpuScene());
+        if (stats) stats[f] = frame;
+        surface.push_back(downloadSurface(context(), renderer.targets()));
+      }
     } catch (...) {
       destroyTubes(context(), tubes);
       throw;
@@ -118,8 +129,8 @@ TEST_F(GpuTubeRaycast, computeRayCastingMatchesTheCpuReferenceOnCurvedTubes) {
 }
 
 // 300 short tubes piled in the same few tiles: up to 1,200 sub-segments a
-// tile, past kTubeTileCapacity, so those tiles test every sub-segment.
-TEST_F(GpuTubeRaycast, tilesWhoseListsOverflowStillDrawEveryTube) {
+// tile.
+Tractogram pileOfTubes() {
   Tractogram t;
   for (int i = 0; i < 300; ++i) {
     const float a = float(i) * 0.02f, z = float(i) * 0.008f;
@@ -127,19 +138,54 @@ TEST_F(GpuTubeRaycast, tilesWhoseListsOverflowStillDrawEveryTube) {
                          2.0f * std::cos(a),  2.0f * std::sin(a),  z};
     t.addStreamline(xyz, 3);
   }
+  return t;
+}
+
+// The lists held to 64 items: the tiles that do not fit test every
+// sub-segment and still draw every tube.
+TEST_F(GpuTubeRaycast, tilesWhoseListsOverflowStillDrawEveryTube) {
+  const Tractogram t = pileOfTubes();
   TubeBuildOptions o;
   o.radius.radius = 0.1f;
   const TubeModel model = buildTubes(t, o);
-  ASSERT_GT(model.subSegmentCount(), size_t(shader::kTubeTileCapacity));
-  Bounds b = tractogramBounds(t);
-  const Camera camera = fitCamera(b, {0.2, -0.3, 1}, {0, 1, 0}, 48, 48);
+  ASSERT_GT(model.subSegmentCount(), size_t(64));
+  const Camera camera = fitCamera(tractogramBounds(t), {0.2, -0.3, 1}, {0, 1, 0}, 48, 48);
   const TubeReferenceImage ref = renderReferenceTubes(model, camera, TubeReferenceMethod::Cascade);
-  FrameStats stats;
-  const Agreement a = compare(castOnGpu(model, camera, &stats), ref, camera);
-  EXPECT_GT(stats.tube_tiles_overflowed, 0u);
-  EXPECT_GT(a.both, 300u) << a.summary();
-  EXPECT_GE(a.agreement(), 0.98) << a.summary();
-  EXPECT_LE(a.fiber_mismatch, a.both / 50) << a.summary();  // tubes overlapping within float depth
+  FrameStats stats[2];
+  const auto frames = castFrames(model, camera, TubeRaycastOptions{64 * sizeof(uint32_t)}, 2, stats);
+  for (int f = 0; f < 2; ++f) {
+    EXPECT_GT(stats[f].tube_tiles_overflowed, 0u) << "frame " << f << ": the limit holds";
+    const Agreement a = compare(frames[f], ref, camera);
+    EXPECT_GT(a.both, 300u) << a.summary();
+    EXPECT_GE(a.agreement(), 0.98) << a.summary();
+    EXPECT_LE(a.fiber_mismatch, a.both / 50) << a.summary();  // tubes overlapping within float depth
+  }
+}
+
+// An 8 x 8 frame is one tile, whose first list holds kTubeTileCapacity
+// items, fewer than the pile puts there: the first frame overflows, the
+// lists grow to its total, and the second frame fits with the same texels
+// (both equal to the reference).
+TEST_F(GpuTubeRaycast, listsGrowToTheFramesTotal) {
+  const Tractogram t = pileOfTubes();
+  TubeBuildOptions o;
+  o.radius.radius = 0.1f;
+  const TubeModel model = buildTubes(t, o);
+  const Camera camera = fitCamera(tractogramBounds(t), {0.2, -0.3, 1}, {0, 1, 0}, 8, 8);
+  FrameStats stats[3];
+  const auto frames = castFrames(model, camera, {}, 3, stats);
+  EXPECT_EQ(stats[0].tube_tiles_overflowed, 1u);
+  EXPECT_EQ(stats[1].tube_tiles_overflowed, 0u);
+  EXPECT_EQ(stats[2].tube_tiles_overflowed, 0u);
+  EXPECT_GT(stats[1].tube_method_bytes, stats[0].tube_method_bytes);
+  EXPECT_EQ(stats[2].tube_method_bytes, stats[1].tube_method_bytes);
+  const TubeReferenceImage ref = renderReferenceTubes(model, camera, TubeReferenceMethod::Cascade);
+  for (int f = 0; f < 3; ++f) {
+    const Agreement a = compare(frames[f], ref, camera);
+    EXPECT_GT(a.both, 16u) << a.summary();
+    EXPECT_GE(a.agreement(), 0.98) << a.summary();
+  }
+  EXPECT_EQ(0, std::memcmp(frames[0].data(), frames[1].data(), frames[0].size() * sizeof(frames[0][0])));
 }
 
 // Lines along x in the plane z = 0 and tubes above them, below them and

@@ -26,11 +26,19 @@ struct GpuTubes {
 GpuTubes uploadTubes(const gpu::VulkanContext& context, const TubeModel& model);
 void destroyTubes(const gpu::VulkanContext& context, GpuTubes& tubes);
 
-// Surfaces: "tube bin" and "tube raycast", the compute ray casting of
-// `tubes` into the surface target (tube_bin.comp, tube_raycast.comp); runs
-// in frames where `tubes` is not null and has segments. `tubes` is read at
-// every frame and must outlive the renderer.
-FrameStageFactory tubeRaycastStage(const GpuTubes* tubes);
+// The compute ray caster's tile lists (shared/tubes.h): the buffer grows
+// to a frame's total for the next frame up to `max_list_bytes` (at most
+// 2^28 items); tiles whose lists do not fit test every sub-segment.
+struct TubeRaycastOptions {
+  uint64_t max_list_bytes = uint64_t(512) << 20;
+};
+
+// Surfaces: "tube bin count", "tube bin offsets", "tube bin fill" and
+// "tube raycast", the compute ray casting of `tubes` into the surface
+// target (tube_bin_*.comp, tube_raycast.comp); runs in frames where `tubes`
+// is not null and has segments. `tubes` is read at every frame and must
+// outlive the renderer.
+FrameStageFactory tubeRaycastStage(const GpuTubes* tubes, TubeRaycastOptions options = {});
 
 // The tube methods name their timed passes "tube ..." (render's and
 // bench's tube time is their sum).
