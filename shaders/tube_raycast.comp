@@ -1,10 +1,10 @@
 // Spline tubes, compute ray casting, pass 2 (shared/tubes.h
 // TubeRaycastPush): one workgroup per screen tile, one invocation per
 // pixel. The tile's sub-segments (its list from the binning passes, or
-// every sub-segment where the list ended past the buffer) are loaded a workgroup's worth at
-// a time into shared memory as quadratics with their boxes; each pixel's
-// eye ray is tested against the boxes and then intersected
-// (glsl/tube_intersect.glsl), the nearest front hit kept against the
+// every sub-segment where the list ended past the buffer) are loaded a
+// workgroup's worth at a time into shared memory as quadratics with their
+// boxes; each pixel's eye ray is tested against the boxes and then
+// intersected (glsl/tube_intersect.glsl), the nearest front hit kept against the
 // surface texel's depth and written (glsl/tube_texel.glsl, shared with the
 // fragment-shader variant's resolve).
 #version 460
