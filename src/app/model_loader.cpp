@@ -58,13 +58,6 @@ void report(const Progress::Sink& sink, const std::string& label) {
   sink(s);
 }
 
-// One line, whatever the exception said.
-std::string oneLine(std::string text) {
-  std::replace(text.begin(), text.end(), '\n', ' ');
-  std::replace(text.begin(), text.end(), '\r', ' ');
-  return text;
-}
-
 // Compresses into a temporary file that is unlinked once mapped (use_cache
 // off): the map keeps the data alive, nothing stays on disk.
 FblCacheEntry compressUncached(const ReaderFactory& open, const CompressOptions& options) {

@@ -14,9 +14,16 @@
 
 namespace fibscope {
 
+// The message as one line: newlines and carriage returns become spaces (a
+// library's message of several lines), every other control byte '?', and
+// trailing spaces go. Names and text taken from input files (a trk scalar
+// name, a TRX member, a JSON key) can hold any byte, and a message must stay
+// one line whatever the file holds. UTF-8 (bytes >= 0x80) passes unchanged.
+std::string oneLine(std::string message);
+
 class Error : public std::runtime_error {
  public:
-  explicit Error(const std::string& message) : std::runtime_error(message) {}
+  explicit Error(const std::string& message) : std::runtime_error(oneLine(message)) {}
 };
 
 // "PATH: MESSAGE"

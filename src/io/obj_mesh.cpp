@@ -116,14 +116,6 @@ std::string checkedText(const std::string& text, const std::string& name) {
   return out;
 }
 
-// tinyobjloader's messages end in newlines, some have several lines.
-std::string oneLine(std::string s) {
-  for (char& c : s)
-    if (c == '\n' || c == '\r') c = ' ';
-  while (!s.empty() && s.back() == ' ') s.pop_back();
-  return s;
-}
-
 double cross2(const glm::dvec2& a, const glm::dvec2& b) { return a.x * b.y - a.y * b.x; }
 
 // Appends the triangles of one face (vertex indices in the file's order).
@@ -184,8 +176,10 @@ TriangleMesh parseObjMesh(const std::string& text, const std::string& name) {
   config.triangulate = false;  // ours handles concave polygons (and counts nothing in a byte)
   config.vertex_color = false;
   tinyobj::ObjReader reader;
-  if (!reader.ParseFromString(checked, "", config)) fail(name, oneLine(reader.Error()));
-  if (!reader.Error().empty()) fail(name, oneLine(reader.Error()));
+  // tinyobjloader's messages end in newlines, some have several lines: fail()
+  // makes them one.
+  if (!reader.ParseFromString(checked, "", config)) fail(name, reader.Error());
+  if (!reader.Error().empty()) fail(name, reader.Error());
 
   TriangleMesh mesh;
   const std::vector<tinyobj::real_t>& v = reader.GetAttrib().vertices;

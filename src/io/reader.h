@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "core/error.h"
 #include "core/tractogram.h"
 
 namespace fibscope {
@@ -35,7 +36,7 @@ class TractogramReader {
   const std::vector<std::string>& warnings() const { return warnings_; }
 
  protected:
-  void warn(const std::string& message) { warnings_.push_back(header_.path + ": " + message); }
+  void warn(const std::string& message) { warnings_.push_back(oneLine(header_.path + ": " + message)); }
   // Empties `chunk` for the next read(): its data arrays follow the header's
   // (names, components, dtypes), keeping their capacity when they already do.
   void startChunk(Tractogram& chunk) const;

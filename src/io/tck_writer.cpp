@@ -127,6 +127,8 @@ void TckWriter::write(const Tractogram& chunk) {
       buffer_.clear();
     }
   }
+  // An empty chunk carries no values, so it need not hold the header's arrays.
+  if (chunk.streamlineCount() == 0) return;
   for (auto& tsf : tsf_)
     if (tsf.writer) writeTsf(tsf, chunk);
 }

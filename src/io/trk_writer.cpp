@@ -12,6 +12,7 @@
 #include "core/byte_order.h"
 #include "core/error.h"
 #include "core/output_file.h"
+#include "io/tck_format.h"  // printableExcerpt
 #include "io/trk_format.h"
 #include "io/writer.h"
 
@@ -167,9 +168,12 @@ const DataArray& TrkWriter::findArray(const std::vector<DataArray>& arrays, cons
   if (index < arrays.size() && arrays[index].name == column.name) found = &arrays[index];
   for (size_t i = 0; !found && i < arrays.size(); ++i)
     if (arrays[i].name == column.name) found = &arrays[i];
-  if (!found) fail(path, std::string("chunk lacks the ") + what + " array '" + column.name + "' named in the header");
+  // Names come from input headers: printable, so the message stays one line.
+  if (!found)
+    fail(path, std::string("chunk lacks the ") + what + " array '" + printableExcerpt(column.name) +
+                   "' named in the header");
   if (found->components != column.components || found->values.size() != expected_values)
-    fail(path, std::string("chunk's ") + what + " array '" + column.name + "' has " +
+    fail(path, std::string("chunk's ") + what + " array '" + printableExcerpt(column.name) + "' has " +
                    std::to_string(found->values.size()) + " values of " + std::to_string(found->components) +
                    " components, expected " + std::to_string(expected_values) + " of " +
                    std::to_string(column.components));
@@ -181,6 +185,9 @@ void TrkWriter::write(const Tractogram& chunk) {
   const std::string problem = chunk.validate();
   if (!problem.empty()) fail(out_.path(), "inconsistent chunk: " + problem);
   const size_t n_streamlines = chunk.streamlineCount();
+  // An empty chunk carries no values, so it need not hold the header's
+  // arrays (a file whose every streamline was dropped is written empty).
+  if (n_streamlines == 0) return;
   const size_t n_points = chunk.pointCount();
   // Map the header's columns to the chunk's arrays (same order, checked by name).
   std::vector<const float*> scalar_values, property_values;

@@ -252,6 +252,8 @@ void TrxWriter::write(const Tractogram& chunk) {
   if (finished_) fail(path_, "internal error: write() after finish()");
   const std::string invalid = chunk.validate();
   if (!invalid.empty()) fail(path_, "internal error: inconsistent chunk: " + invalid);
+  // An empty chunk carries no values, so it need not hold the header's arrays.
+  if (chunk.streamlineCount() == 0) return;
   checkArrays(chunk.per_streamline, per_streamline_, "per-streamline");
   checkArrays(chunk.per_point, per_point_, "per-point");
 

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "core/error.h"
 #include "core/tractogram.h"
 
 namespace fibscope {
@@ -49,7 +50,7 @@ class TractogramWriter {
   const std::vector<std::string>& warnings() const { return warnings_; }
 
  protected:
-  void warn(const std::string& message) { warnings_.push_back(message); }
+  void warn(const std::string& message) { warnings_.push_back(oneLine(message)); }
   std::vector<std::string> warnings_;
 };
 

@@ -22,12 +22,6 @@ using nlohmann::json;
 constexpr uint64_t kMaxRoiSetBytes = 16u << 20;  // a set is a few kB; refuse to parse a stray large file
 constexpr int kMaxDepth = 8;                     // the schema nests 3 deep
 
-std::string oneLine(std::string s) {
-  std::replace_if(
-      s.begin(), s.end(), [](char c) { return c == '\n' || c == '\r'; }, ' ');
-  return s;
-}
-
 const char* typeName(const json& v) {
   if (v.is_number()) return "a number";
   if (v.is_string()) return "a string";

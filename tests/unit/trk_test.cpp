@@ -709,5 +709,56 @@ TEST(TrkAffine, rasToVoxmmToRasRoundTripsWithinFloatPrecision) {
   EXPECT_LE(worst, 3e-5);  // a few float ulps at 120 mm (ulp = 7.6e-6)
 }
 
+
+// Found by fuzz_trk: a file whose only streamline is truncated away reads as
+// no streamlines under a header that still names its arrays (one of them
+// with a newline in its name). Writing that back must give an empty file in
+// every format, not an error ("chunk lacks the array"), whose message
+// carried the raw name over two lines.
+TEST(TrkWriter, emptyTractogramUnderAHeaderNamingArraysWritesInEveryFormat) {
+  TempDir dir;
+  TrkBytes b;
+  b.scalarName(0, "a\nb");
+  b.propertyName(0, "w");
+  b.counts(1, 1, 1);
+  b.put<int32_t>(1000, 3);  // 3 points of 4 floats and 1 property promised, 2 floats given
+  b.put<float>(1004, 1.0f);
+  b.put<float>(1008, 2.0f);
+  Tractogram t;
+  TractogramHeader h;
+  std::vector<std::string> warnings;
+  ASSERT_EQ(readAll(b.save(dir), &t, &warnings, &h), "");
+  ASSERT_EQ(t.streamlineCount(), 0u);
+  ASSERT_EQ(h.per_point.size(), 1u);
+  ASSERT_EQ(h.per_streamline.size(), 1u);
+  EXPECT_EQ(h.per_point[0].name, "a\nb");
+  WriterOptions options;
+  options.overwrite = true;
+  for (const char* name : {"out.trk", "out.tck"}) {
+    const std::string out = dir.file(name);
+    std::vector<std::string> dropped;
+    ASSERT_NO_THROW(writeTractogram(out, t, h, options, &dropped)) << name;
+    for (const std::string& w : dropped) EXPECT_EQ(w.find('\n'), std::string::npos) << w;
+    Tractogram chunk;
+    EXPECT_FALSE(openTractogram(out)->read(chunk)) << name;
+  }
+  // TRX stores each array as a file named after it: a newline cannot be one.
+  // The refusal is one line that names the output.
+  try {
+    writeTractogram(dir.file("out.trx"), t, h, options);
+    ADD_FAILURE() << "a TRX member named 'a\\nb' was written";
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    EXPECT_NE(message.find("out.trx"), std::string::npos) << message;
+    EXPECT_NE(message.find("'a b'"), std::string::npos) << message;
+  }
+  // Under valid names the same empty tractogram is an empty TRX.
+  h.per_point[0].name = "ab";
+  ASSERT_NO_THROW(writeTractogram(dir.file("valid.trx"), t, h, options));
+  Tractogram chunk;
+  EXPECT_FALSE(openTractogram(dir.file("valid.trx"))->read(chunk));
+}
+
 }  // namespace
 }  // namespace fibscope
