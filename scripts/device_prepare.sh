@@ -30,8 +30,14 @@ done | sort -u | grep -v -E '/(libc|libm|libstdc\+\+|libgcc_s|libdl|libpthread|l
 cp /usr/lib/x86_64-linux-gnu/libVkLayer_khronos_validation.so .gl/lib/
 sed 's#"library_path": "libVkLayer_khronos_validation.so"#"library_path": "../lib/libVkLayer_khronos_validation.so"#' \
   /usr/share/vulkan/explicit_layer.d/VkLayer_khronos_validation.json > .gl/layers/VkLayer_khronos_validation.json
+# The tree that travels holds 64 MiB at most (the repository's files too):
+# the binaries and libraries travel xz-packed (the unit tests need Embree's
+# 42 MB) and env.sh unpacks them there.
+tar -C .gl -cf - bin lib layers | xz -T0 -6 > .gl/pack.tar.xz
+rm -rf .gl/bin .gl/lib .gl/layers
 cat > .gl/env.sh <<'ENV'
 # Sourced first by every device command (from the repository root there).
+[ -f .gl/pack.tar.xz ] && xz -dc .gl/pack.tar.xz | tar -C .gl -xf - && rm .gl/pack.tar.xz
 for f in .gl/*.deb; do dpkg -x "$f" /; done; ldconfig
 export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
 export __EGL_VENDOR_LIBRARY_FILENAMES=/usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json

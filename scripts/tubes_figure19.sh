@@ -16,7 +16,9 @@
 # the orbit, for lavapipe; large: sets B and D, 2 frames sampled (on
 # lavapipe a frame of B takes tens of seconds, tessellated D hours: D
 # there without tess, METHODS_D). Writes OUT/<set>-<size>-<far|close>.json
-# and OUT/table.md. FRAMES, SAMPLE, METHODS and METHODS_D override.
+# and OUT/table.md. FRAMES, SAMPLE, METHODS and METHODS_D override; SAMPLE_D
+# samples set D alone (a lent GPU's time is counted), TIMEOUT (seconds)
+# bounds each bench run (a case over it is left out of the table).
 set -euo pipefail
 out=${1:?output folder}
 scale=${2:-full}
@@ -24,6 +26,7 @@ fibscope=${FIBSCOPE:-build/fibscope}
 methods=${METHODS:-none,compute,raycast,tess}
 frames=${FRAMES:-500}
 sample=${SAMPLE:-0}
+limit=${TIMEOUT:-0}
 [ "$scale" = small ] && sample=${SAMPLE:-6}
 [ "$scale" = large ] && sample=${SAMPLE:-2}
 mkdir -p "$out"
@@ -54,11 +57,14 @@ for s in "${sets[@]}"; do
       [ "$view" = close ] && distance=0.3
       json="$out/$name-$size-$view.json"
       these=$methods
-      [ "$name" = D ] && these=$methods_d
+      this_sample=$sample
+      [ "$name" = D ] && these=$methods_d && this_sample=${SAMPLE_D:-$sample}
       echo "set $name ($tubes of $fibers fibers) $size $view: $these" >&2
-      "$fibscope" bench --phantom-streamlines "$fibers" --tubes "$tubes" --tube-tolerance "$tolerance" \
-        --tube-radius "$radius" --tube-compare "$these" --size "$size" --distance "$distance" \
-        --frames "$frames" --step "$(python3 -c "print(360 / $frames)")" --sample "$sample" --json > "$json"
+      timeout "$limit" "$fibscope" bench --phantom-streamlines "$fibers" --tubes "$tubes" \
+        --tube-tolerance "$tolerance" --tube-radius "$radius" --tube-compare "$these" --size "$size" \
+        --distance "$distance" --frames "$frames" --step "$(python3 -c "print(360 / $frames)")" \
+        --sample "$this_sample" --json > "$json.part" || { echo "  failed or over ${limit} s: left out" >&2; continue; }
+      mv "$json.part" "$json"
     done
   done
 done

@@ -66,6 +66,7 @@ struct BenchOptions {
   // the previous frame the full orbit would have shown it; the fractions
   // drawn estimate the full orbit's at 2N / frames of its cost.
   uint32_t sample = 0;
+  uint32_t filter_evaluations = 1;
   bool count_missed = false;
   bool json = false;
 };
@@ -273,7 +274,7 @@ void runBench(const BenchOptions& o) {
   }
   // The criteria, evaluated once: each variant's frames read the kept bits
   // of its pipeline's input.
-  const SceneFilter filter(*context, scene, criteria, o.render.dim_dropped);
+  const SceneFilter filter(*context, scene, criteria, o.render.dim_dropped, int(o.filter_evaluations));
   const SceneCuts cuts(*context, o.render);
   cuts.apply(gpu_scene);
   std::vector<GpuScene> variant_scenes(variants.size(), gpu_scene);
@@ -424,7 +425,9 @@ void runBench(const BenchOptions& o) {
   out["fiblets"] = scene.fiblets.block().fiblet_count;
   if (filter.active()) {
     out["filter"]["kept"] = filter.kept();
-    out["filter"]["gpu_ms"] = filter.gpuMilliseconds();
+    out["filter"]["gpu_ms"] = filter.gpuMilliseconds();  // the median of the evaluations
+    out["filter"]["gpu_ms_each"] = filter.gpuMillisecondsEach();
+    if (scene.has_raw) out["filter"]["raw_gpu_ms"] = filter.rawGpuMilliseconds();
   }
   // Ratios compare GPU time, except on a CPU device (lavapipe): there the
   // timestamps around the passes of a large dataset (34 M segments, 2-D
@@ -554,6 +557,11 @@ void addBenchCommand(CLI::App& app) {
   cmd->add_option("--sample", o->sample,
                   "Measure N frames spread evenly over the orbit, each after the frame one step before it "
                   "(0: every frame)")
+      ->capture_default_str();
+  cmd->add_option("--filter-evaluations", o->filter_evaluations,
+                  "Evaluate the --include/--exclude/length criteria on the fiblets N times, each re-testing every "
+                  "criterion as a changed ROI does (JSON: filter.gpu_ms, their median, and filter.gpu_ms_each)")
+      ->check(CLI::Range(1u, 1000u))
       ->capture_default_str();
   cmd->add_flag("--count-missed", o->count_missed,
                 "Also draw each measured frame with culling off (frustum culling with the same LoD when LoD is on; "

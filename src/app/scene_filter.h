@@ -7,6 +7,7 @@
 #pragma once
 
 #include <memory>
+#include <vector>
 
 #include "app/render_scene.h"
 #include "render/gpu/scene.h"
@@ -22,8 +23,12 @@ class SceneFilter {
   // Evaluates `criteria` (nothing when empty) with the margin of the
   // scene's step size; its scalar ranges read scene.fiber_scalars (loaded
   // with SceneOptions::fiber_scalars = the same ranges). Throws Error as
-  // GpuFiberFilter::update does.
-  SceneFilter(const gpu::VulkanContext& context, const LoadedScene& scene, const FilterCriteria& criteria, bool dim);
+  // GpuFiberFilter::update does. `evaluations` > 1 evaluates the fiblets'
+  // filter that many times (each re-tests every criterion, as a changed
+  // sphere does), for a median time: the first evaluation of a run also
+  // pays for cold caches and a GPU's clock ramp.
+  SceneFilter(const gpu::VulkanContext& context, const LoadedScene& scene, const FilterCriteria& criteria, bool dim,
+              int evaluations = 1);
 
   bool active() const { return fiblets_ != nullptr; }
   // Sets what a frame of `pipeline` reads: scene.kept_bits (and
@@ -38,12 +43,18 @@ class SceneFilter {
   // The kept fibers' indices, ascending (downloaded); empty when inactive.
   std::vector<uint32_t> keptFibers() const;
   uint64_t fibers() const { return fiblets_ ? fiblets_->fiberCount() : 0; }
-  double gpuMilliseconds() const { return gpu_ms_; }
+  // GPU time of one evaluation on the fiblets: the median of the evaluations.
+  double gpuMilliseconds() const;
+  // Each evaluation's GPU time on the fiblets, in order.
+  const std::vector<double>& gpuMillisecondsEach() const { return gpu_ms_; }
+  // GPU time of the evaluation on the raw vertices (0 without them).
+  double rawGpuMilliseconds() const { return raw_gpu_ms_; }
 
  private:
   std::unique_ptr<GpuFiberFilter> fiblets_, raw_;
   bool dim_ = false;
-  double gpu_ms_ = 0;
+  std::vector<double> gpu_ms_;
+  double raw_gpu_ms_ = 0;
 };
 
 }  // namespace fibscope

@@ -245,6 +245,34 @@ TEST_F(GpuCliRender, benchReportsTheOrbitAsJson) {
   EXPECT_EQ(json["results"][1]["fiblets_drawn_fraction"].get<double>(), 1.0) << "no culling draws every fiblet";
 }
 
+// The filter's figure (issue 14: one changed sphere re-evaluated within a
+// frame): each of --filter-evaluations re-tests every criterion; the JSON's
+// gpu_ms is their median, its count the CPU filter's (the fiblets' decoded
+// points within the codec's error of the file's).
+TEST_F(GpuCliRender, benchTimesTheFilterOverItsEvaluations) {
+  const std::string tck = dir_.file("in.tck");
+  ASSERT_EQ(test::runFibscope("phantom " + tck + " -n 300 --seed 5").exit_code, 0);
+  const std::string criteria = " --include sphere:-20,0,10,25 --exclude sphere:0,-40,0,10";
+  const auto r = runGpuFibscope("bench --validate --json --size 96x64 --frames 1 --warmup 0 " + tck +
+                                " --compare compute/two-phase,raw-compute --filter-evaluations 3" + criteria);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto json = nlohmann::json::parse(r.output.substr(r.output.find('{')));
+  const auto& f = json["filter"];
+  ASSERT_EQ(f["gpu_ms_each"].size(), 3u) << f.dump();
+  std::vector<double> each = f["gpu_ms_each"].get<std::vector<double>>();
+  std::sort(each.begin(), each.end());
+  EXPECT_EQ(f["gpu_ms"].get<double>(), each[1]) << f.dump();
+  EXPECT_GT(each[0], 0.0) << f.dump();
+  EXPECT_GT(f["raw_gpu_ms"].get<double>(), 0.0) << "raw-compute compared: its filter is timed too";
+  const auto cpu = test::runFibscope("filter " + tck + " " + dir_.file("kept.tck") + criteria);
+  ASSERT_EQ(cpu.exit_code, 0) << cpu.output;
+  const uint64_t cpu_kept = keptCount(cpu.output, "kept.tck: ");
+  ASSERT_GT(cpu_kept, 5u);
+  EXPECT_NEAR(f["kept"].get<double>(), double(cpu_kept), 2.0);
+  EXPECT_NE(runGpuFibscope("bench --phantom-streamlines 20 --frames 1 --filter-evaluations 0" + criteria).exit_code,
+            0);
+}
+
 // --sample measures frames spread over the orbit, each after the frame one
 // step before it: two-phase culling then draws on each exactly what it
 // draws on that frame of the full orbit (its previous frame is the same),

@@ -100,6 +100,9 @@ class GpuFiberFilter {
   std::vector<float> zoneDistanceValues() const;  // downloaded; empty without a zone
   // GPU time of the last update's passes (ms), 0 when it did no work.
   double lastGpuMilliseconds() const { return last_ms_; }
+  // The next update() runs its passes even for the same criteria and
+  // sources (what a changed criterion costs, for benchmarks).
+  void invalidate() { signature_.clear(); }
 
  private:
   struct Packed;
