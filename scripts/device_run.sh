@@ -47,7 +47,7 @@ if [ "$scale" = small ]; then
 else
   part filter 100 scripts/device_filter.sh "$res/filter" 1000000
   part bundle 110 env TIMEOUT=40 scripts/device_bundle.sh "$res/bundle" paper
-  part figure19 200 env TIMEOUT=25 SAMPLE_D=50 scripts/tubes_figure19.sh "$res/figure19" full
+  part figure19 200 env TIMEOUT=30 SAMPLE_D=20 scripts/tubes_figure19.sh "$res/figure19" full
   tests='Gpu*'
 fi
 
