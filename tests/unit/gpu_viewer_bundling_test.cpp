@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <string>
 
@@ -43,6 +44,25 @@ TEST(ViewerBundlingScript, parsesBundleWaitShowAndSave) {
   // The defaults are the paper's.
   const auto plain = parseScript("bundle\n", "s.txt");
   EXPECT_EQ(std::get<BundleAction>(std::get<ViewerAction>(plain[0].command)).params.iterations, 15u);
+}
+
+TEST(ViewerBundlingScript, parsesSplitViewOnAndOff) {
+  const auto steps = parseScript("split-view 0 1\nsplit-view off\n", "s.txt");
+  ASSERT_EQ(steps.size(), 2u);
+  const auto& on = std::get<SplitViewAction>(std::get<ViewerAction>(steps[0].command));
+  EXPECT_TRUE(on.on);
+  EXPECT_EQ(on.left, 0);
+  EXPECT_EQ(on.right, 1);
+  EXPECT_FALSE(std::get<SplitViewAction>(std::get<ViewerAction>(steps[1].command)).on);
+  for (const char* bad : {"split-view\n", "split-view 1\n", "split-view 0 x\n", "split-view -1 2\n",
+                          "split-view 0 1 2\n"}) {
+    try {
+      parseScript(bad, "s.txt");
+      ADD_FAILURE() << "accepted: " << bad;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("s.txt"), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(ViewerBundlingScript, malformedBundleLinesNameTheLine) {
@@ -130,6 +150,66 @@ TEST_F(GpuViewerBundling, quittingWhileBundlingCancelsTheJobAndLeavesNoFiles) {
   EXPECT_LT(seconds, 60.0) << "1000 iterations were not run to the end";
   const auto left = test::runCommand("find '" + tmp + "' -type f | wc -l");
   EXPECT_EQ(std::atoi(left.output.c_str()), 0) << left.output;
+}
+
+// Pixels of `half` (a w x h image) that equal `full`'s at column x0 + x
+// (RGB within 8 of 255), counted over the pixels drawn in either.
+double agreeingDrawnFraction(const test::Png& half, const test::Png& full, uint32_t x0) {
+  size_t drawn = 0, agree = 0;
+  for (uint32_t y = 0; y < half.height; ++y)
+    for (uint32_t x = 0; x < half.width; ++x) {
+      const uint8_t* a = half.at(x, y);
+      const uint8_t* b = full.at(x0 + x, y);
+      const bool lit_a = a[0] + a[1] + a[2] > 30, lit_b = b[0] + b[1] + b[2] > 30;
+      if (!lit_a && !lit_b) continue;
+      ++drawn;
+      agree += std::abs(a[0] - b[0]) <= 8 && std::abs(a[1] - b[1]) <= 8 && std::abs(a[2] - b[2]) <= 8;
+    }
+  return drawn ? double(agree) / double(drawn) : 0.0;
+}
+
+test::Png crop(const test::Png& p, uint32_t x0, uint32_t width) {
+  test::Png out;
+  out.width = width;
+  out.height = p.height;
+  for (uint32_t y = 0; y < p.height; ++y)
+    out.rgba.insert(out.rgba.end(), p.at(x0, y), p.at(x0, y) + 4 * width);
+  return out;
+}
+
+// The split view: the original in the left half, the bundled copy in the
+// right, one camera. A half's camera is the full one at half the width with
+// the eye twice as far (split_view.h), so each half must show exactly the
+// centre half of that model's full-width frame after a dolly to twice the
+// distance (log 2 / log 1.1 = 7.2725 wheel steps out); screen-space effects
+// off (SSAO and FXAA read neighbours across the crop's edges). Turning the
+// split off leaves the camera: the single view is the one before.
+TEST_F(GpuViewerBundling, splitViewShowsTheOriginalLeftAndTheBundledCopyRightFromOneCamera) {
+  const std::string before = dir_.file("before.png"), split = dir_.file("split.png"), after = dir_.file("after.png"),
+                    full0 = dir_.file("full0.png"), full1 = dir_.file("full1.png"), script = dir_.file("s.txt");
+  test::writeBytes(script, "wait-loaded\nview coronal\nset ssao off\nset fxaa off\nset orientation-labels off\n"
+                           "set background 0,0,0\nbundle radius=4 iterations=2 voxel=2\nwait-bundle\n"
+                           "show-model 0\nwait 1\nscreenshot " + before + " 128x72\n"
+                           "split-view 0 1\nwait 2\nscreenshot " + split + " 128x72\n"
+                           "split-view off\nshow-model 0\nwait 1\nscreenshot " + after + " 128x72\n"
+                           "dolly -7.272540897\nwait 1\nscreenshot " + full0 + " 128x72\n"
+                           "show-model 1\nwait 1\nscreenshot " + full1 + " 128x72\n"
+                           "split-view 0 9\nquit\n");
+  const auto r = runViewer("--offscreen --size 160x90 --phantom-streamlines 300 --script " + script);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const test::Png a = test::readOurPng(full0), b = test::readOurPng(full1), s = test::readOurPng(split);
+  ASSERT_EQ(s.width, 128u);
+  ASSERT_EQ(a.width, 128u);
+  ASSERT_EQ(b.width, 128u);
+  const test::Png left = crop(s, 0, 64), right = crop(s, 64, 64);
+  ASSERT_GT(drawnPixels(left), 100u);
+  ASSERT_GT(drawnPixels(right), 100u);
+  EXPECT_GE(agreeingDrawnFraction(left, a, 32), 0.98) << "left half: the original's centre";
+  EXPECT_GE(agreeingDrawnFraction(right, b, 32), 0.98) << "right half: the bundled copy's centre";
+  EXPECT_LT(agreeingDrawnFraction(right, a, 32), 0.9) << "the right half is not the original";
+  EXPECT_EQ(differingPixels(test::readOurPng(after), test::readOurPng(before)), 0u)
+      << "split-view off gives the single view back";
+  EXPECT_NE(r.output.find("split-view 0 9: no such model"), std::string::npos) << r.output;
 }
 
 TEST_F(GpuViewerBundling, aSaveToAnExistingFileOrWithoutAModelIsAMessage) {

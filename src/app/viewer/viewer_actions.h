@@ -149,6 +149,12 @@ struct CancelBundleAction {};
 struct ShowOnlyModelAction {
   int model = -1;
 };
+// The split view (viewer_state.h SplitViewInfo): on with models LEFT and
+// RIGHT side by side, or off (the models' own visibility again).
+struct SplitViewAction {
+  bool on = false;
+  int left = -1, right = -1;
+};
 // Model N's fibers written by PATH's extension as `fibscope bundle` writes
 // (app/bundle_output.h): its source file read again (a bundled copy's is its
 // exact positions), else its .fbl, else the phantom. An existing PATH is refused.
@@ -162,7 +168,7 @@ using ViewerAction = std::variant<OrbitAction, PanAction, DollyAction, ViewActio
                                   ExportSelectionAction, ExpectSelectedAction, DissectionAction, RoiSetFileAction,
                                   ExportKeptAction, ExpectKeptAction, RoiPlaceAction, RoiDragAction, RoiResizeAction,
                                   ResizeAction, QuitAction, AnatomyAction, SliceStepAction, BundleAction,
-                                  CancelBundleAction, ShowOnlyModelAction, SaveModelAction, TubesAction>;
+                                  CancelBundleAction, ShowOnlyModelAction, SplitViewAction, SaveModelAction, TubesAction>;
 
 // Sets one RenderSettings field from text, as `set KEY VALUE` in a script:
 // KEY is a setting's name in render/settings_table.h (the command line's

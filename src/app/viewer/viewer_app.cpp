@@ -24,6 +24,7 @@
 #include "app/viewer/orbit_controller.h"
 #include "app/viewer/presentation.h"
 #include "app/viewer/recent_files.h"
+#include "app/viewer/split_view.h"
 #include "app/viewer/viewer_cuts.h"
 #include "app/viewer/viewer_anatomy.h"
 #include "app/viewer/viewer_dissection.h"
@@ -168,6 +169,14 @@ class ViewerApp {
   // waiting for a drag to settle).
   FrameScene currentScene(bool filter_now = false);
   FrameScene sceneToDraw();
+  // The split view (split_view.h): on, with both of its models loaded.
+  bool splitActive() const;
+  // One model alone, for a half of the split view: the compute pipeline
+  // (the baselines draw one raw tractogram), the dissection's cuts, not its
+  // filter (its kept bits are numbered for the whole scene).
+  FrameScene modelScene(int model);
+  // Both halves recorded and composed into `out` (width x height RGBA8).
+  void recordSplit(VkCommandBuffer cmd, const Camera& camera, const gpu::Buffer& out);
   // The dissection (viewer_dissection.h) on `scene`: its cuts in the
   // settings, its kept bits in the GpuScene.
   void dissect(FrameScene& scene, bool now);
@@ -230,6 +239,8 @@ class ViewerApp {
   // Coarse frames (adaptive detail) at half resolution, upscaled into
   // renderer_'s colour buffer; both made at the first coarse frame.
   std::unique_ptr<FrameRenderer> coarse_renderer_;
+  std::unique_ptr<FrameRenderer> split_renderers_[2];  // the split view's halves (left, right)
+  bool split_recorded_ = false;                        // the frame in flight is a split one
   UpscalePass upscale_;
   bool upscale_ready_ = false;
   // The renderer that recorded the frame last submitted (its statistics and
@@ -414,6 +425,7 @@ void ViewerApp::release() {
   imgui_.reset();
   shot_renderer_.reset();
   coarse_renderer_.reset();
+  for (auto& r : split_renderers_) r.reset();
   recorded_renderer_ = nullptr;
   if (upscale_ready_) destroyUpscalePass(*context_, upscale_);
   upscale_ready_ = false;
@@ -589,6 +601,9 @@ void ViewerApp::closeModel(int model) {
   shift(state_.active_model);
   shift(state_.bundling.source_model);
   shift(state_.bundling.bundled_model);
+  shift(state_.split.left);
+  shift(state_.split.right);
+  if (state_.split.left < 0 || state_.split.right < 0) state_.split = {};
   scene_lengths_->invalidate();
   drawn_layout_ = {};  // the G-buffer may show the closed model: no picks until the next frame
   drawn_ids_.clear();
@@ -750,6 +765,46 @@ FrameScene ViewerApp::sceneToDraw() {
   return scene;
 }
 
+bool ViewerApp::splitActive() const {
+  const int n = int(scenes_.size());
+  const SplitViewInfo& s = state_.split;
+  return s.on && s.left >= 0 && s.left < n && s.right >= 0 && s.right < n;
+}
+
+FrameScene ViewerApp::modelScene(int model) {
+  FrameScene scene;
+  scene.settings = state_.settings;
+  if (!drawsFiblets(scene.settings.pipeline)) scene.settings.pipeline = RenderPipeline::Compute;
+  const ViewerModel& m = *scenes_[size_t(model)];
+  scene.models = {model};
+  scene.gpu.datasets = {&m.fiblets};
+  scene.layout = sceneLayout(scene.gpu.datasets);
+  scene.gpu.fiber_scalars = m.fiblets.fiberLength().address;  // one dataset: its own lengths
+  addDissectionCuts(state_.dissection.set, scene.settings);
+  try {
+    cuts_->sync(state_.dissection);
+    cuts_->apply(state_.dissection.set, scene.gpu);
+  } catch (const Error& e) {
+    state_.status = e.what();
+  }
+  scene.gpu.anatomy = anatomy_.gpu();
+  return scene;
+}
+
+void ViewerApp::recordSplit(VkCommandBuffer cmd, const Camera& camera, const gpu::Buffer& out) {
+  const int models[2] = {state_.split.left, state_.split.right};
+  for (const int k : {0, 1}) {
+    const Camera half = splitHalfCamera(camera, k == 1);
+    std::unique_ptr<FrameRenderer>& r = split_renderers_[k];
+    if (!r) r = std::make_unique<FrameRenderer>(*context_, half.width, half.height, frameStages());
+    else if (r->targets().width != half.width || r->targets().height != half.height) r->resize(half.width, half.height);
+    const FrameScene scene = modelScene(models[k]);
+    r->record(cmd, half, scene.settings, scene.gpu);
+  }
+  recordSplitCompose(cmd, split_renderers_[0]->targets().color, split_renderers_[1]->targets().color, out,
+                     camera.width, camera.height);
+}
+
 // The baselines draw raw vertices, decoded when such a pipeline is first
 // chosen for a model: on a thread (pollRawDecode uploads them), the frames
 // going on with the compute pipeline meanwhile.
@@ -904,6 +959,15 @@ void ViewerApp::apply(const ViewerAction& action) {
           } else {
             for (size_t i = 0; i < state_.models.size(); ++i) state_.models[i].visible = int(i) == a.model;
             state_.active_model = a.model;
+          }
+        } else if constexpr (std::is_same_v<A, SplitViewAction>) {
+          const int n = int(state_.models.size());
+          if (a.on && !(a.left >= 0 && a.left < n && a.right >= 0 && a.right < n)) {
+            state_.status = "split-view " + std::to_string(a.left) + " " + std::to_string(a.right) +
+                            ": no such model (" + std::to_string(n) + " loaded)";
+            std::fprintf(stderr, "fibscope view: %s\n", state_.status.c_str());
+          } else {
+            state_.split = {a.on, a.on ? a.left : -1, a.on ? a.right : -1};
           }
         } else if constexpr (std::is_same_v<A, SaveModelAction>) {
           saveModel(a);
@@ -1195,14 +1259,20 @@ void ViewerApp::takeScreenshot(const ScreenshotAction& shot) {
   try {
     finishFrame();
     controller_.finishAnimation();
-    const FrameScene scene = currentScene();
-    if (scene.empty()) throw Error("screenshot: no visible model to draw");
     if (!shot_renderer_)
       shot_renderer_ = std::make_unique<FrameRenderer>(*context_, shot.width, shot.height, frameStages());
     shot_renderer_->resize(shot.width, shot.height);
     const Camera camera = anatomy_.inView(controller_.camera(shot.width, shot.height));
-    syncSelection(scene);
-    shot_renderer_->render(camera, scene.settings, withSelection(scene));
+    if (splitActive()) {
+      // The split view at the shot's size, composed in the shot's colour buffer.
+      gpu::submitOnce(*context_, [&](VkCommandBuffer cmd) { recordSplit(cmd, camera, shot_renderer_->targets().color); });
+      for (auto& r : split_renderers_) r->collect();
+    } else {
+      const FrameScene scene = currentScene();
+      if (scene.empty()) throw Error("screenshot: no visible model to draw");
+      syncSelection(scene);
+      shot_renderer_->render(camera, scene.settings, withSelection(scene));
+    }
     writePngRgba(path, shot.width, shot.height, downloadColor(*context_, shot_renderer_->targets()));
     controller_.setViewport(presentation_.width, presentation_.height);  // camera() noted the shot's size
     state_.status = "saved " + path;
@@ -1378,6 +1448,12 @@ void ViewerApp::finishFrame() {
   FrameRecord record;
   record.frame_ms = last_frame_ms_;
   record.gpu = (recorded_renderer_ ? recorded_renderer_ : renderer_.get())->collect();
+  if (split_recorded_ && split_renderers_[1]) {
+    // The right half's passes too: the frame's GPU time is both halves'.
+    const FrameStats right = split_renderers_[1]->collect();
+    record.gpu.gpu_ms += right.gpu_ms;
+    record.gpu.passes.insert(record.gpu.passes.end(), right.passes.begin(), right.passes.end());
+  }
   state_.addFrame(std::move(record));
 }
 
@@ -1400,7 +1476,14 @@ void ViewerApp::recordFrame(VkCommandBuffer cmd, uint32_t width, uint32_t height
   drawn_ids_.clear();
   frame_coarse_ = false;
   recorded_renderer_ = nullptr;
-  if (!scene.empty()) {
+  split_recorded_ = false;
+  if (splitActive()) {
+    // Two models side by side (no picking: nothing is numbered for it).
+    // No frame is in flight here (drawFrame's currentScene waited for it).
+    recordSplit(cmd, camera, renderer_->targets().color);
+    recorded_renderer_ = split_renderers_[0].get();
+    split_recorded_ = true;
+  } else if (!scene.empty()) {
     RenderSettings settings = scene.settings;
     // Adaptive detail (adaptive_detail.h). Moving: the camera differs from
     // the last frame's (slow frames settle the controller's smoothing within

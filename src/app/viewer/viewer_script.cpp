@@ -387,6 +387,19 @@ std::variant<ViewerAction, WaitFrames, WaitLoaded, WaitExported, WaitBundled> pa
     }
     return ViewerAction{SaveModelAction{int(n), path}};
   }
+  if (name == "split-view") {
+    expectArguments(w, 1, 2, "split-view LEFT RIGHT | split-view off");
+    if (w.size() == 2 && w[1] == "off") return ViewerAction{SplitViewAction{}};
+    if (w.size() != 3) throw Error("split-view: expected two model indices (LEFT RIGHT) or 'off'");
+    SplitViewAction split{true};
+    for (const int k : {1, 2}) {
+      const double n = number(w[size_t(k)], k == 1 ? "LEFT" : "RIGHT");
+      if (!(n >= 0 && n < 65536) || n != std::floor(n))
+        throw Error("split-view: expected a model index from 0 (the first opened), got " + std::string(w[size_t(k)]));
+      (k == 1 ? split.left : split.right) = int(n);
+    }
+    return ViewerAction{split};
+  }
   if (name == "quit") {
     expectArguments(w, 0, 0, "quit");
     return ViewerAction{QuitAction{}};
@@ -396,7 +409,7 @@ std::variant<ViewerAction, WaitFrames, WaitLoaded, WaitExported, WaitBundled> pa
               "pick, clear-selection, export-selection, expect-selected, roi-add, roi-place, roi-remove, "
               "roi-enable, ends-only, length, fiber-scalar, fiber-scalar-clear, clip-plane-add, clip-plane-clear, cut-mesh-add, cut-mesh-clear, slab, "
               "dropped, roi-save, roi-load, "
-              "export-kept, expect-kept, resize, anatomy, bundle, wait-bundle, show-model, save-model or quit)");
+              "export-kept, expect-kept, resize, anatomy, bundle, wait-bundle, show-model, split-view, save-model or quit)");
 }
 
 }  // namespace

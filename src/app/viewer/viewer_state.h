@@ -66,6 +66,15 @@ struct BundlingInfo {
   std::string save_path = "bundled.tck";
 };
 
+// The split view (split_view.h): model `left` in the window's left half,
+// `right` in the right half, from one camera. While it is on, picking and
+// the dissection's filter are off (each half is a scene of its own
+// numbering); cuts, anatomy and every render setting apply to both.
+struct SplitViewInfo {
+  bool on = false;
+  int left = -1, right = -1;  // indices into models
+};
+
 // One frame's numbers, kept for the performance overlay's history.
 struct FrameRecord {
   double frame_ms = 0;  // wall time between frame starts (CPU side)
@@ -195,6 +204,7 @@ struct ViewerState {
   std::string status;
 
   BundlingInfo bundling;
+  SplitViewInfo split;
   TubesInfo tubes;
 
   // UI flags.

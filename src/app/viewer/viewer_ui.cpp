@@ -208,6 +208,7 @@ std::vector<ViewerAction> drawViewerUi(ViewerState& state) {
   if (state.show_performance) performanceOverlay(state);
   if (state.show_selection) drawSelectionPanel(state, actions);
   drawDissectionOverlay(state);
+  drawSplitViewOverlay(state);
   if (state.show_dissection) drawDissectionPanel(state, actions);
   if (state.show_anatomy) drawAnatomyPanel(state, actions);
   if (state.show_bundling) drawBundlingPanel(state, actions);

@@ -44,9 +44,12 @@ void drawDissectionOverlay(const ViewerState& state);
 // range, opacity, sampling, the slab following the active slice).
 void drawAnatomyPanel(ViewerState& state, std::vector<ViewerAction>& actions);
 // viewer_ui_bundling.cpp: the Bundle panel (the bundling parameters, Bundle
-// and Cancel, the job's progress with rate and ETA, original / bundled,
-// Save bundled...).
+// and Cancel, the job's progress with rate and ETA, original / bundled /
+// side by side, Save bundled...).
 void drawBundlingPanel(ViewerState& state, std::vector<ViewerAction>& actions);
+// viewer_ui_bundling.cpp: over a split view, each half's model name and the
+// line between the halves.
+void drawSplitViewOverlay(const ViewerState& state);
 // viewer_ui_tubes.cpp: the Tubes panel (selection / filtered fibers as
 // spline tubes, radius, tolerance, method, rings, vertices, MSAA, the
 // last build).

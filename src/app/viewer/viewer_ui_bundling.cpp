@@ -1,6 +1,6 @@
 // The Bundle panel (viewer_ui.h): the bundling parameters (BundleParams,
 // the paper's defaults), a Bundle button for the active model, the running
-// job's progress with rate and ETA, the original / bundled toggle and
+// job's progress with rate and ETA, the original / bundled / side-by-side toggle and
 // "Save bundled...". Like the other panels it edits ViewerState and asks
 // for the rest through actions (BundleAction, ShowOnlyModelAction, ...).
 #include <imgui.h>
@@ -79,12 +79,26 @@ void drawBundlingPanel(ViewerState& state, std::vector<ViewerAction>& actions) {
   if (b.bundled_model >= 0 && b.bundled_model < n) {
     ImGui::Separator();
     const bool original_ok = b.source_model >= 0 && b.source_model < n;
-    int shown = state.models[size_t(b.bundled_model)].visible ? 1 : 0;
+    const bool split = state.split.on && state.split.left == b.source_model && state.split.right == b.bundled_model;
+    const int shown = split ? 2 : state.models[size_t(b.bundled_model)].visible ? 1 : 0;
     ImGui::BeginDisabled(!original_ok);
-    if (ImGui::RadioButton("original", shown == 0) && original_ok) actions.push_back(ShowOnlyModelAction{b.source_model});
+    if (ImGui::RadioButton("original", shown == 0) && original_ok) {
+      actions.push_back(SplitViewAction{});
+      actions.push_back(ShowOnlyModelAction{b.source_model});
+    }
     ImGui::EndDisabled();
     ImGui::SameLine();
-    if (ImGui::RadioButton("bundled", shown == 1)) actions.push_back(ShowOnlyModelAction{b.bundled_model});
+    if (ImGui::RadioButton("bundled", shown == 1)) {
+      actions.push_back(SplitViewAction{});
+      actions.push_back(ShowOnlyModelAction{b.bundled_model});
+    }
+    ImGui::SameLine();
+    ImGui::BeginDisabled(!original_ok);
+    if (ImGui::RadioButton("side by side", shown == 2) && original_ok)
+      actions.push_back(SplitViewAction{true, b.source_model, b.bundled_model});
+    ImGui::EndDisabled();
+    if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+      ImGui::SetTooltip("original left, bundled right, one camera (no picking, no ROI filter meanwhile)");
     ImGui::SetNextItemWidth(160);
     ImGui::InputText("##save", &b.save_path);
     ImGui::SameLine();
@@ -96,6 +110,26 @@ void drawBundlingPanel(ViewerState& state, std::vector<ViewerAction>& actions) {
     ImGui::PopTextWrapPos();
   }
   ImGui::End();
+}
+
+void drawSplitViewOverlay(const ViewerState& state) {
+  const SplitViewInfo& split = state.split;
+  const int n = int(state.models.size());
+  if (!split.on || split.left < 0 || split.left >= n || split.right < 0 || split.right >= n) return;
+  const ImGuiViewport* viewport = ImGui::GetMainViewport();
+  ImDrawList* draw = ImGui::GetBackgroundDrawList();  // under the panels, over the frame
+  // The halves split the whole window (the frame), not the work area.
+  const float middle = viewport->Pos.x + float(int(viewport->Size.x) / 2);
+  draw->AddLine(ImVec2(middle, viewport->Pos.y), ImVec2(middle, viewport->Pos.y + viewport->Size.y),
+                IM_COL32(200, 200, 200, 160), 1.0f);
+  const float top = viewport->WorkPos.y + 6;
+  auto label = [&](int model, float x) {
+    const std::string& name = state.models[size_t(model)].name;
+    draw->AddText(ImVec2(x + 1, top + 1), IM_COL32(0, 0, 0, 200), name.c_str());
+    draw->AddText(ImVec2(x, top), IM_COL32(255, 255, 255, 230), name.c_str());
+  };
+  label(split.left, viewport->Pos.x + 8);
+  label(split.right, middle + 8);
 }
 
 }  // namespace fibscope
