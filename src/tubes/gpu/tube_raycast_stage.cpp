@@ -117,8 +117,11 @@ class TubeRaycastStage final : public FrameStage {
     wanted_items_ = 0;
   }
 
-  shader::TubeBinPush binPush(const FrameContext& frame, TileGrid grid) const {
-    shader::TubeBinPush push{};
+  // The fields the binning passes and the ray caster share (their push
+  // structs differ in the rest).
+  template <typename Push>
+  Push tilePush(const FrameContext& frame, TileGrid grid) const {
+    Push push{};
     push.camera = frame.targets.camera.address;
     push.nodes = tubes_->nodes.address;
     push.segments = tubes_->segments.address;
@@ -127,8 +130,13 @@ class TubeRaycastStage final : public FrameStage {
     push.tile_lists = tile_lists_.address;
     push.sub_segments = tubes_->subSegmentCount();
     push.tiles_x = grid.x;
-    push.tiles_y = grid.y;
     push.list_capacity = list_capacity_;
+    return push;
+  }
+
+  shader::TubeBinPush binPush(const FrameContext& frame, TileGrid grid) const {
+    shader::TubeBinPush push = tilePush<shader::TubeBinPush>(frame, grid);
+    push.tiles_y = grid.y;
     return push;
   }
 
@@ -152,19 +160,10 @@ class TubeRaycastStage final : public FrameStage {
 
   void recordRaycast(FrameContext& frame, TileGrid grid) {
     gpu::PassScope pass(frame.cmd, frame.timer, "tube raycast", gpu::kComputeToCompute);
-    shader::TubeRaycastPush push{};
-    push.camera = frame.targets.camera.address;
-    push.nodes = tubes_->nodes.address;
-    push.segments = tubes_->segments.address;
-    push.tile_counts = tile_counts_.address;
-    push.tile_ends = tile_ends_.address;
-    push.tile_lists = tile_lists_.address;
+    shader::TubeRaycastPush push = tilePush<shader::TubeRaycastPush>(frame, grid);
     push.surface = frame.targets.surface.address;
-    push.sub_segments = tubes_->subSegmentCount();
-    push.tiles_x = grid.x;
     push.width = frame.targets.width;
     push.height = frame.targets.height;
-    push.list_capacity = list_capacity_;
     gpu::recordDispatch(frame.cmd, raycast_, push, grid.x, grid.y);
   }
 
