@@ -111,7 +111,10 @@ unsigned long long numberAfter(const std::string& text, const std::string& key) 
 TEST_F(GpuViewerBundling, bundlesWhileFramesGoOnTogglesSavesAndReopens) {
   const std::string original = dir_.file("original.png"), bundled = dir_.file("bundled.png");
   const std::string saved = dir_.file("bundled.tck"), script = dir_.file("s.txt");
-  test::writeBytes(script, "wait-loaded\nview coronal\nbundle radius=4 iterations=2 voxel=2\nwait-bundle\n"
+  // Eight iterations: about a second here (a dozen frames for each two
+  // iterations on an idle host), so the frames drawn meanwhile stay above
+  // the bound when another lavapipe test shares the cores.
+  test::writeBytes(script, "wait-loaded\nview coronal\nbundle radius=4 iterations=8 voxel=2\nwait-bundle\n"
                            "show-model 0\nwait 1\nscreenshot " + original + " 96x64\n"
                            "show-model 1\nwait 1\nscreenshot " + bundled + " 96x64\n"
                            "save-model 1 " + saved + "\nquit\n");
