@@ -2,7 +2,7 @@
 // its samples at equal arc-length intervals len / (n - 1) along the
 // polyline, the first and the last on its end points (n = the host's
 // sample count, bundling/bundle_setup.h; a fiber of one sample keeps its
-// first point).
+// first point). The points are a chunk's (shared/bundling.h).
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_buffer_reference : require
@@ -16,12 +16,13 @@ layout(local_size_x_id = WORKGROUP_SIZE_X_ID) in;  // kBundleGroupSize
 layout(push_constant, std430) uniform Push { BundleFiberPush pc; };
 
 void main() {
-  const uint fiber = bundleInvocation();
-  if (fiber >= pc.fiber_count) return;
+  const uint local = bundleInvocation();
+  if (local >= pc.fiber_count) return;
+  const uint fiber = pc.fiber_first + local;
   BundleFloatsRef points = BundleFloatsRef(pc.points);
   BundleVec4Ref samples = BundleVec4Ref(pc.samples);
-  const uint p0 = BundleUintsRef(pc.point_offsets).values[fiber];
-  const uint p1 = BundleUintsRef(pc.point_offsets).values[fiber + 1u];
+  const uint p0 = BundleUintsRef(pc.point_offsets).values[fiber] - pc.point_base;  // in the chunk
+  const uint p1 = BundleUintsRef(pc.point_offsets).values[fiber + 1u] - pc.point_base;
   const uint s0 = BundleUintsRef(pc.sample_offsets).values[fiber];
   const uint s1 = BundleUintsRef(pc.sample_offsets).values[fiber + 1u];
   if (s1 == s0 || p1 == p0) return;

@@ -29,4 +29,31 @@ vec3 bundlePoint(BundleFloatsRef points, uint i) {
   return vec3(points.values[3u * i], points.values[3u * i + 1u], points.values[3u * i + 2u]);
 }
 
+// The density at voxel index i: floats, or the anisotropic splat's fixed
+// point (is_count: uint values times scale).
+float bundleDensity(uint64_t density, uint is_count, float scale, uint i) {
+  return is_count != 0u ? float(BundleUintsRef(density).values[i]) * scale : BundleFloatsRef(density).values[i];
+}
+
+// One component of the gradient at voxel `index` (coordinate `at` of n
+// along the axis, `stride` apart): (D[i+1] - D[i-1]) / 2h, one-sided
+// (D[i+1] - D[i]) / h at the grid's faces, 0 on a grid one voxel thick.
+float bundleDifference(uint64_t density, uint is_count, float scale, float voxel, uint index, uint at, uint n,
+                       uint stride) {
+  if (n < 2u) return 0.0;
+  const uint lo = at > 0u ? index - stride : index;
+  const uint hi = at + 1u < n ? index + stride : index;
+  const float span = float((at + 1u < n ? 1u : 0u) + (at > 0u ? 1u : 0u)) * voxel;
+  return (bundleDensity(density, is_count, scale, hi) - bundleDensity(density, is_count, scale, lo)) / span;
+}
+
+// The density's gradient at voxel v (world units): what the gradient pass
+// writes and the advection interpolates.
+vec3 bundleGradientAt(BundleGridBlock g, uint64_t density, uint is_count, float scale, uvec3 v) {
+  const uint index = bundleVoxelIndex(g, v.x, v.y, v.z);
+  return vec3(bundleDifference(density, is_count, scale, g.voxel, index, v.x, g.nx, 1u),
+              bundleDifference(density, is_count, scale, g.voxel, index, v.y, g.ny, g.nx),
+              bundleDifference(density, is_count, scale, g.voxel, index, v.z, g.nz, g.nx * g.ny));
+}
+
 #endif

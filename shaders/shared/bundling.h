@@ -16,14 +16,20 @@
 //             it, Rb = anisotropy R across (an ellipsoid elongated along
 //             the fiber); fixed point (kBundleSplatScale per unit) so the
 //             integer atomics keep bundling deterministic
-//   gradient  per voxel: central differences of the density (one-sided at
-//             the grid's faces), world units
+//   gradient  central differences of the density (one-sided at the grid's
+//             faces), world units: taken by the advection at the 8 voxels
+//             around each sample (glsl/bundling.glsl), so no gradient grid
+//             is kept; the gradient pass writes that grid only for the
+//             tests (GpuBundlerOptions::keep_stages)
 //   advect    per sample: p += R h (g - d (d . g)) / |g| with g the
 //             trilinear gradient at p, d the fiber's unit direction there
 //   smooth    per sample: p = (1 - phi) p + phi mean(p_j, |j - i| <= k)
 //   relax     per sample: p = o + alpha (p - o), o its unbundled position
 //   map back  per fiber: every original point moves by its sample
-//             displacement interpolated at its arc length
+//             displacement interpolated at its arc length, in place
+// Resampling and mapping back see the model's points a chunk of whole
+// fibers at a time (fiber_first, point_base), so the input points are not
+// on the device during the iterations.
 // Grid: voxel (i, j, k) is the cube origin + h [i, i + 1) x ...; its
 // centre is origin + h (i + 0.5, ...); index i + nx (j + ny k).
 #ifndef FIBSCOPE_SHADERS_SHARED_BUNDLING_H
@@ -59,18 +65,18 @@ struct BundleGridBlock {
   uint pad0;
 };
 
-// Resampling and mapping back (one invocation per fiber).
+// Resampling and mapping back (one invocation per fiber of a chunk).
 struct BundleFiberPush {
-  uint64_t points;          // float x, y, z per original point
-  uint64_t point_offsets;   // uint per fiber + 1
+  uint64_t points;          // float x, y, z per point of the chunk (point_offsets[f] - point_base)
+  uint64_t point_offsets;   // uint per fiber + 1 (the whole model's)
   uint64_t sample_offsets;  // uint per fiber + 1
   uint64_t samples;         // resample: out; map back: the bundled samples (vec4)
   uint64_t originals;       // map back: the unbundled samples (vec4)
-  uint64_t moved;           // map back: float x, y, z per original point
-  uint fiber_count;
+  uint64_t moved;           // map back: float x, y, z per point of the chunk (may be `points`)
+  uint fiber_count;         // fibers in the chunk
+  uint fiber_first;         // the chunk's first fiber
+  uint point_base;          // point_offsets[fiber_first]: the chunk's first point
   uint pad0;
-  uint pad1;
-  uint pad2;
 };
 
 // Counting, advection, smoothing and relaxation (one invocation per sample).
@@ -80,20 +86,22 @@ struct BundleSamplePush {
   uint64_t dst;             // vec4 per sample
   uint64_t sample_fiber;    // uint per sample: its fiber
   uint64_t sample_offsets;  // uint per fiber + 1
-  uint64_t field;           // count: uint per voxel; advect: vec4 gradient per voxel; relax: the originals
+  uint64_t field;           // count: uint per voxel; advect: the density per voxel; relax: the originals
   uint sample_count;
   float step;               // advect: R h (mm); smooth: phi; relax: alpha
   uint window;              // smooth: k
   uint anchor_ends;         // 1: the first and last sample of a fiber stay
   float radius_along;       // splat: Ra (voxels)
   float radius_across;      // splat: Rb (voxels)
+  uint field_is_count;      // advect: 1 when the density is the splat's fixed point (uint)
+  float field_scale;        // advect: field_is_count's uint values times this
 };
 
 // Density along one axis and gradient (one invocation per voxel).
 struct BundleGridPush {
   BundleGridBlock grid;
-  uint64_t src;       // density: uint counts (src_is_count) or float; gradient: float density
-  uint64_t dst;       // float per voxel; gradient: vec4 per voxel
+  uint64_t src;       // density: uint counts (src_is_count) or float; gradient: the density
+  uint64_t dst;       // float per voxel (the y pass may write into the counts); gradient: vec4 per voxel
   uint axis;          // 0 x, 1 y, 2 z
   uint src_is_count;  // 1: src holds uint counts
   float radius;       // R in voxels
@@ -106,7 +114,7 @@ struct BundleGridPush {
 static_assert(sizeof(BundleGridBlock) == 32);
 static_assert(sizeof(BundleFiberPush) == 64);
 static_assert(offsetof(BundleFiberPush, fiber_count) == 48);
-static_assert(sizeof(BundleSamplePush) == 96);
+static_assert(sizeof(BundleSamplePush) == 104);
 static_assert(offsetof(BundleSamplePush, src) == 32);
 static_assert(offsetof(BundleSamplePush, sample_count) == 72);
 static_assert(sizeof(BundleGridPush) == 72);

@@ -88,7 +88,7 @@ void addBundleCommand(CLI::App& app) {
       progress.set(double(it + 1));
     }
     Tractogram bundled = model;
-    bundled.positions = bundler.finish();
+    bundled.positions = bundler.finish(model);
     progress.finish();
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 

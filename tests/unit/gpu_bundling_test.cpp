@@ -14,6 +14,7 @@
 #include "bundling/bundle_reference.h"
 #include "bundling/bundle_setup.h"
 #include "bundling/gpu/gpu_bundler.h"
+#include "core/error.h"
 #include "bundling_test_model.h"
 #include "gpu_test_context.h"
 
@@ -64,7 +65,7 @@ TEST_F(GpuBundling, resamplingMatchesTheReference) {
 }
 
 TEST_F(GpuBundling, eachStageOfAnIterationMatchesTheReference) {
-  GpuBundler bundler(context());
+  GpuBundler bundler(context(), GpuBundlerOptions{.keep_stages = true});
   bundler.load(model_, setup_, params_);
   const BundleSamples before = toDouble(bundler.samples());
   const double radius = params_.radius;
@@ -141,7 +142,7 @@ TEST_F(GpuBundling, wholeIterationAndFinishMatchTheReference) {
   EXPECT_GT(mean_move, 0.5);  // it did move (mm), far beyond the tolerance
 
   // Relaxation and mapping back of the GPU's samples.
-  const std::vector<float> moved = bundler.finish();
+  const std::vector<float> moved = bundler.finish(model_);
   const std::vector<float> expect =
       mapBackReference(model_, setup_, original, relaxReference(original, toDouble(gpu), params_.relaxation));
   ASSERT_EQ(moved.size(), model_.positions.size());
@@ -162,7 +163,7 @@ TEST_F(GpuBundling, bundlingTwiceGivesBitIdenticalPointsWithTheSameOffsets) {
   EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0);
   EXPECT_NE(a, model_.positions);
   EXPECT_EQ(reported, params_.iterations);
-  EXPECT_GE(bytes, setup_.grid.voxelCount() * 24);
+  EXPECT_GE(bytes, setup_.grid.voxelCount() * 8 + setup_.sampleCount() * 48);
   EXPECT_FALSE(times.empty());
   // The whole run stays near the reference's (float vs double over a few
   // iterations: loose, but far below the motion).
@@ -178,6 +179,47 @@ TEST_F(GpuBundling, bundlingTwiceGivesBitIdenticalPointsWithTheSameOffsets) {
   EXPECT_LT(mean_err, 0.01 * mean_move);
 }
 
+TEST_F(GpuBundling, smallChunksGiveBitIdenticalPointsInLessMemory) {
+  // The model (20-41 points a fiber, about 87 KB) is one chunk by default.
+  // 1000 B chunks hold two to four fibers each, so it goes up in dozens;
+  // 400 B ones are shorter than its longest fibers, which then take a chunk
+  // each. The result must not depend on where the chunks fall.
+  size_t longest = 0;
+  for (size_t f = 0; f < model_.streamlineCount(); ++f)
+    longest = std::max<size_t>(longest, model_.offsets[f + 1] - model_.offsets[f]);
+  const GpuBundlerOptions small{.chunk_bytes = 1000}, tiny{.chunk_bytes = 400};
+  ASSERT_GT(longest * 12, tiny.chunk_bytes);
+  ASSERT_GT(model_.pointCount() * 12, 50 * small.chunk_bytes);
+  uint64_t big_bytes = 0, small_bytes = 0, tiny_bytes = 0, staged_bytes = 0;
+  const std::vector<float> a = bundleOnGpu(context(), model_, params_, {}, nullptr, &big_bytes);
+  const std::vector<float> b = bundleOnGpu(context(), model_, params_, {}, nullptr, &small_bytes, small);
+  const std::vector<float> c = bundleOnGpu(context(), model_, params_, {}, nullptr, &tiny_bytes, tiny);
+  const std::vector<float> d = bundleOnGpu(context(), model_, params_, {}, nullptr, &staged_bytes,
+                                           GpuBundlerOptions{.keep_stages = true});
+  ASSERT_EQ(a.size(), model_.positions.size());
+  ASSERT_EQ(b.size(), a.size());
+  ASSERT_EQ(c.size(), a.size());
+  ASSERT_EQ(d.size(), a.size());
+  EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0);
+  EXPECT_EQ(std::memcmp(a.data(), c.data(), a.size() * sizeof(float)), 0);  // fibers over a chunk
+  EXPECT_EQ(std::memcmp(a.data(), d.data(), a.size() * sizeof(float)), 0);  // the stage grids change nothing
+  EXPECT_LT(small_bytes, big_bytes);
+  // Every 400 B chunk is one fiber, so the chunk buffer is the longest's.
+  EXPECT_EQ(big_bytes - tiny_bytes, (model_.pointCount() - longest) * 12);
+  EXPECT_EQ(staged_bytes, big_bytes + setup_.grid.voxelCount() * 20);
+}
+
+TEST_F(GpuBundling, stageGridsNeedKeepStages) {
+  GpuBundler bundler(context());
+  bundler.load(model_, setup_, params_);
+  bundler.iterate(params_.radius);
+  EXPECT_THROW(bundler.counts(), Error);
+  EXPECT_THROW(bundler.gradient(), Error);
+  EXPECT_EQ(bundler.density().size(), setup_.grid.voxelCount());
+  Tractogram other = test::wavyBundlingModel(10);
+  EXPECT_THROW(bundler.finish(other), Error);
+}
+
 TEST_F(GpuBundling, anchoredEndsStayWhereTheyWere) {
   params_.anchor_ends = true;
   const std::vector<float> a = bundleOnGpu(context(), model_, params_);
@@ -188,7 +230,7 @@ TEST_F(GpuBundling, anchoredEndsStayWhereTheyWere) {
 
 TEST_F(GpuBundling, anisotropicSplatAndIterationMatchTheReference) {
   params_.mode = BundleMode::Anisotropic;
-  GpuBundler bundler(context());
+  GpuBundler bundler(context(), GpuBundlerOptions{.keep_stages = true});
   bundler.load(model_, setup_, params_);
   const BundleSamples original = toDouble(bundler.originalSamples());
   bundler.iterate(params_.radius);

@@ -148,7 +148,7 @@ void ViewerBundling::run(ViewerBundleSource source, BundleParams params) {
         bundler.iterate(bundleRadius(params, it));
         progress.set(double(it + 1));
       }
-      moved = bundler.finish();
+      moved = bundler.finish(model);
     }
     progress.finish();
     stopIfCancelled();

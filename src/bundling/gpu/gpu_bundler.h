@@ -1,12 +1,18 @@
-// Fiber bundling on the GPU (FiberVisualizer section 7): the model's
-// points and the plan of bundling/bundle_setup.h go up once, the passes of
-// shared/bundling.h run per iteration (one submission each, so a caller
-// can report progress between them), the bundled points come back with
-// the model's own offsets. Deterministic: integer counts, fixed sums.
+// Fiber bundling on the GPU (FiberVisualizer section 7): the plan of
+// bundling/bundle_setup.h goes up once, the model's points a chunk of whole
+// fibers at a time (resampled, then mapped back in place at the end: they
+// are not on the device during the iterations), the passes of
+// shared/bundling.h run per iteration (one submission each, so a caller can
+// report progress between them), the bundled points come back with the
+// model's own offsets. Deterministic: integer counts, fixed sums.
 //
-// Device memory: 12 B per point twice (in, out), 8 B per fiber, 52 B per
-// sample (three vec4 copies, its fiber), 24 B per voxel (count, two
-// density buffers, a vec4 gradient). bytes() says what one load holds.
+// Device memory: 8 B per fiber; 52 B per sample (three vec4 copies, its
+// fiber); 8 B per voxel isotropic (counts, density; the separable density's
+// middle pass writes into the counts), 4 B anisotropic (the splat's
+// density); one chunk of points (GpuBundlerOptions::chunk_bytes, or the
+// longest fiber). No gradient grid: the advection takes the gradient from
+// the density at the voxels around each sample. bytes() says what one load
+// holds (the staging copies of the chunks are host memory).
 #pragma once
 
 #include <glm/glm.hpp>
@@ -26,10 +32,21 @@
 
 namespace fibscope {
 
+struct GpuBundlerOptions {
+  // Points on the device at a time (resampling, mapping back): whole fibers
+  // up to this many bytes (12 a point), more when one fiber needs it.
+  uint64_t chunk_bytes = uint64_t(64) << 20;
+  // For the tests of each stage: keep the counts apart from the density
+  // passes' scratch and write the gradient grid (the advection does not
+  // read it), so counts() and gradient() show this iteration's. 20 B a
+  // voxel more.
+  bool keep_stages = false;
+};
+
 class GpuBundler {
  public:
   // Makes the pipelines (throws Error when they cannot be made).
-  explicit GpuBundler(const gpu::VulkanContext& context);
+  explicit GpuBundler(const gpu::VulkanContext& context, const GpuBundlerOptions& options = {});
   ~GpuBundler();
   GpuBundler(const GpuBundler&) = delete;
   GpuBundler& operator=(const GpuBundler&) = delete;
@@ -41,15 +58,18 @@ class GpuBundler {
   // gradient, advection, smoothing. Submits and waits.
   void iterate(double radius);
   // Relaxation (alpha = params.relaxation) and mapping back: the bundled
-  // points, x y z per point of the loaded tractogram. Submits and waits.
-  std::vector<float> finish();
+  // points, x y z per point of `tractogram` (the one given to load). Submits
+  // and waits, a chunk at a time.
+  std::vector<float> finish(const Tractogram& tractogram);
 
   // For tests: the state after load / the last iterate (downloaded).
   std::vector<glm::vec4> originalSamples() const;
   std::vector<glm::vec4> samples() const;   // current (after smoothing)
   std::vector<glm::vec4> advected() const;  // after the last advection
-  std::vector<uint32_t> counts() const;     // anisotropic: the splat's fixed-point density
-  std::vector<float> density() const;       // after the z pass (isotropic)
+  // keep_stages only (throw Error otherwise): the counts (anisotropic: the
+  // splat's fixed-point density) and the gradient grid.
+  std::vector<uint32_t> counts() const;
+  std::vector<float> density() const;  // after the z pass (isotropic)
   std::vector<glm::vec4> gradient() const;
 
   uint64_t bytes() const;  // device memory of the loaded model
@@ -58,16 +78,22 @@ class GpuBundler {
 
  private:
   void release();
+  void releaseBuffers();
   void addTimes();
+  // The first fiber of each chunk, then the fiber count.
+  std::vector<uint32_t> planChunks(const Tractogram& tractogram, uint64_t* most_points) const;
+  shader::BundleFiberPush chunkPush(const Tractogram& tractogram, size_t chunk) const;
   const gpu::VulkanContext& context_;
+  GpuBundlerOptions options_;
   BundlePipelines pipelines_;
   gpu::GpuTimer timer_;
   gpu::Buffer points_, point_offsets_, sample_offsets_, sample_fiber_, original_, current_, scratch_;
-  gpu::Buffer counts_, density_, density_tmp_, gradient_, moved_;
+  gpu::Buffer counts_, density_, density_tmp_, gradient_;  // the last two: keep_stages
   BundleSetup setup_;
   BundleParams params_;
   uint32_t fibers_ = 0;
   uint64_t points_count_ = 0;
+  std::vector<uint32_t> chunks_;
   std::vector<gpu::PassTime> times_;
 };
 
@@ -75,6 +101,7 @@ class GpuBundler {
 // (`progress` called after each with the iterations done), finish.
 std::vector<float> bundleOnGpu(const gpu::VulkanContext& context, const Tractogram& tractogram,
                                const BundleParams& params, const std::function<void(uint32_t done)>& progress = {},
-                               std::vector<gpu::PassTime>* times = nullptr, uint64_t* device_bytes = nullptr);
+                               std::vector<gpu::PassTime>* times = nullptr, uint64_t* device_bytes = nullptr,
+                               const GpuBundlerOptions& options = {});
 
 }  // namespace fibscope
