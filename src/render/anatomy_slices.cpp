@@ -103,23 +103,4 @@ std::array<Vec3d, 8> volumeCorners(const AnatomyGrid& grid) {
   return corners;
 }
 
-Camera enclosingDepthRange(Camera camera, std::span<const Vec3d> points) {
-  const glm::dvec3 eye(camera.eye[0], camera.eye[1], camera.eye[2]);
-  const glm::dvec3 forward =
-      glm::normalize(glm::dvec3(camera.target[0], camera.target[1], camera.target[2]) - eye);
-  double nearest = INFINITY, farthest = 0;
-  for (const Vec3d& p : points) {
-    const double d = glm::dot(glm::dvec3(p[0], p[1], p[2]) - eye, forward);
-    if (!(d > 0)) continue;  // behind the eye: no near plane shows it
-    nearest = std::min(nearest, d);
-    farthest = std::max(farthest, d);
-  }
-  if (!(farthest > 0)) return camera;
-  camera.far_mm = std::max(camera.far_mm, 1.01 * farthest);
-  // Not nearer than a thousandth of the far plane: the depth buffer's
-  // float precision near the far plane falls with far / near.
-  camera.near_mm = std::min(camera.near_mm, std::max(0.99 * nearest, 1e-3 * camera.far_mm));
-  return camera;
-}
-
 }  // namespace fibscope

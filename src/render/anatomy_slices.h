@@ -81,10 +81,4 @@ void fitAnatomySettings(RenderSettings& settings, const AnatomyGrid& grid, Value
 // dim - 0.5) in world mm.
 std::array<Vec3d, 8> volumeCorners(const AnatomyGrid& grid);
 
-// The camera with near and far widened (never narrowed) so that the
-// points in front of the eye lie between them with a 1 % margin (near not
-// below far / 1000): cameras are framed on the tractogram, and a slice of a
-// larger head would be cut by the far (or near) plane.
-Camera enclosingDepthRange(Camera camera, std::span<const Vec3d> points);
-
 }  // namespace fibscope

@@ -69,6 +69,16 @@ struct Bounds {
 // Bounds of every point; a tractogram without points gives a box of size 0
 // at the origin.
 Bounds tractogramBounds(const Tractogram& tractogram);
+// The box's 8 corners (bit k of the index picks max on axis k).
+std::array<Vec3d, 8> boundsCorners(const Bounds& bounds);
+
+// The camera with near and far widened (never narrowed) so that the
+// points in front of the eye lie between them with a 1 % margin (near not
+// below far / 1000): cameras are framed on one box (a tractogram, the
+// models visible when the last came in), and an anatomical slice of a
+// larger head, or a model shown later, would be cut by the far or near
+// plane.
+Camera enclosingDepthRange(Camera camera, std::span<const Vec3d> points);
 
 // Places the eye on the ray from the box centre along `direction` (need not
 // be unit), looking at the centre with `up`, far enough that the box's

@@ -6,13 +6,16 @@
 // commands are tested without a GPU.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <string>
 
 #include "app/viewer/viewer_script.h"
 #include "core/error.h"
+#include "io/writer.h"
 #include "test_support.h"
 
 namespace fibscope {
@@ -180,26 +183,51 @@ test::Png crop(const test::Png& p, uint32_t x0, uint32_t width) {
   return out;
 }
 
+// The distance factor the viewer reports when the split view goes on
+// ("each half's eye F x as far"); 0 when it reports none.
+double splitFactorIn(const std::string& output) {
+  const std::string key = "each half's eye ";
+  const size_t at = output.find(key);
+  return at == std::string::npos ? 0.0 : std::strtod(output.c_str() + at + key.size(), nullptr);
+}
+
+// Wheel steps that move the eye `factor` times as far (one step: 1.1x).
+std::string dollyOut(double factor) {
+  char steps[32];
+  std::snprintf(steps, sizeof steps, "%.9f", -std::log(factor) / std::log(1.1));
+  return steps;
+}
+
 // The split view: the original in the left half, the bundled copy in the
 // right, one camera. A half's camera is the full one at half the width with
-// the eye twice as far (split_view.h), so each half must show exactly the
-// centre half of that model's full-width frame after a dolly to twice the
-// distance (log 2 / log 1.1 = 7.2725 wheel steps out); screen-space effects
-// off (SSAO and FXAA read neighbours across the crop's edges). Turning the
-// split off leaves the camera: the single view is the one before.
+// the eye F times as far (split_view.h: twice, times the ratio of the two
+// models' union to the box the camera was framed on, here the bundled copy
+// alone), so each half must show exactly the centre half of that model's
+// full-width frame after a dolly to F times the distance; screen-space
+// effects off (SSAO and FXAA read neighbours across the crop's edges).
+// Turning the split off gives the single view back. A first run reads F
+// (the bundling is deterministic), the second dollies by it.
 TEST_F(GpuViewerBundling, splitViewShowsTheOriginalLeftAndTheBundledCopyRightFromOneCamera) {
   const std::string before = dir_.file("before.png"), split = dir_.file("split.png"), after = dir_.file("after.png"),
                     full0 = dir_.file("full0.png"), full1 = dir_.file("full1.png"), script = dir_.file("s.txt");
-  test::writeBytes(script, "wait-loaded\nview coronal\nset ssao off\nset fxaa off\nset orientation-labels off\n"
-                           "set background 0,0,0\nbundle radius=4 iterations=2 voxel=2\nwait-bundle\n"
-                           "show-model 0\nwait 1\nscreenshot " + before + " 128x72\n"
-                           "split-view 0 1\nwait 2\nscreenshot " + split + " 128x72\n"
-                           "split-view off\nshow-model 0\nwait 1\nscreenshot " + after + " 128x72\n"
-                           "dolly -7.272540897\nwait 1\nscreenshot " + full0 + " 128x72\n"
-                           "show-model 1\nwait 1\nscreenshot " + full1 + " 128x72\n"
-                           "split-view 0 9\nquit\n");
-  const auto r = runViewer("--offscreen --size 160x90 --phantom-streamlines 300 --script " + script);
+  const std::string setup = "wait-loaded\nview coronal\nset ssao off\nset fxaa off\nset orientation-labels off\n"
+                            "set background 0,0,0\nbundle radius=4 iterations=2 voxel=2\nwait-bundle\n";
+  const std::string args = "--offscreen --size 160x90 --phantom-streamlines 300 --script " + script;
+  test::writeBytes(script, setup + "split-view 0 1\nwait 1\nquit\n");
+  const auto first = runViewer(args);
+  ASSERT_EQ(first.exit_code, 0) << first.output;
+  const double factor = splitFactorIn(first.output);
+  ASSERT_GE(factor, 2.0) << first.output;
+  EXPECT_LT(factor, 2.5) << "a bundled copy hardly smaller than its original: " << first.output;
+  test::writeBytes(script, setup + "show-model 0\nwait 1\nscreenshot " + before + " 128x72\n"
+                                   "split-view 0 1\nwait 2\nscreenshot " + split + " 128x72\n"
+                                   "split-view off\nshow-model 0\nwait 1\nscreenshot " + after + " 128x72\n"
+                                   "dolly " + dollyOut(factor) + "\nwait 1\nscreenshot " + full0 + " 128x72\n"
+                                   "show-model 1\nwait 1\nscreenshot " + full1 + " 128x72\n"
+                                   "split-view 0 9\nquit\n");
+  const auto r = runViewer(args);
   ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(splitFactorIn(r.output), factor) << r.output;
   const test::Png a = test::readOurPng(full0), b = test::readOurPng(full1), s = test::readOurPng(split);
   ASSERT_EQ(s.width, 128u);
   ASSERT_EQ(a.width, 128u);
@@ -213,6 +241,66 @@ TEST_F(GpuViewerBundling, splitViewShowsTheOriginalLeftAndTheBundledCopyRightFro
   EXPECT_EQ(differingPixels(test::readOurPng(after), test::readOurPng(before)), 0u)
       << "split-view off gives the single view back";
   EXPECT_NE(r.output.find("split-view 0 9: no such model"), std::string::npos) << r.output;
+}
+
+// Nothing of a larger model falls outside its half when the camera was
+// framed on the smaller one: a tractogram and its copy shrunk to half about
+// the box centre, the copy opened with the original hidden (so the camera
+// frames the copy alone, as it frames a bundled copy). The halves' eye goes
+// back 2 x 2 = 4 times (the union's diagonal is twice the copy's), the left
+// half is the centre of the original's frame at 4x the distance, nothing of
+// it touches its half's left or right edge, and both models show at one
+// scale (the copy's drawn width half the original's, within 2 px). The
+// full-width reference is the single view with the original shown again:
+// its near and far enclose every visible model, not only the framed copy
+// (before, they cut the original's front and back: 77 % agreement).
+TEST_F(GpuViewerBundling, splitViewFramesTheUnionOfItsModelsWhenTheCameraWasFramedOnTheSmaller) {
+  const Tractogram big = test::smallTractogram(60, 3);
+  Tractogram small = big;
+  float lo[3] = {1e30f, 1e30f, 1e30f}, hi[3] = {-1e30f, -1e30f, -1e30f};
+  for (size_t i = 0; i < big.pointCount(); ++i)
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], big.point(i)[k]), hi[k] = std::max(hi[k], big.point(i)[k]);
+  for (size_t i = 0; i < small.positions.size(); ++i) {
+    const float centre = (lo[i % 3] + hi[i % 3]) / 2;
+    small.positions[i] = centre + 0.5f * (small.positions[i] - centre);
+  }
+  const std::string big_tck = dir_.file("big.tck"), small_tck = dir_.file("small.tck");
+  writeTractogram(big_tck, big, TractogramHeader{});
+  writeTractogram(small_tck, small, TractogramHeader{});
+  const std::string split = dir_.file("split.png"), full0 = dir_.file("full0.png"), full1 = dir_.file("full1.png"),
+                    script = dir_.file("s.txt");
+  test::writeBytes(script, "wait-loaded\nview coronal\nset ssao off\nset fxaa off\nset orientation-labels off\n"
+                           "set background 0,0,0\nmodel 0 hide\nopen " + small_tck + "\nwait-loaded\n"
+                           "split-view 0 1\nwait 2\nscreenshot " + split + " 128x72\nsplit-view off\n"
+                           "dolly " + dollyOut(4.0) + "\nshow-model 0\nwait 1\nscreenshot " + full0 + " 128x72\n"
+                           "show-model 1\nwait 1\nscreenshot " + full1 + " 128x72\nquit\n");
+  const auto r = runViewer("--offscreen --size 160x90 --script " + script + " " + big_tck);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NEAR(splitFactorIn(r.output), 4.0, 1e-3) << r.output;
+  const test::Png s = test::readOurPng(split), a = test::readOurPng(full0), b = test::readOurPng(full1);
+  ASSERT_EQ(s.width, 128u);
+  const test::Png left = crop(s, 0, 64), right = crop(s, 64, 64);
+  ASSERT_GT(drawnPixels(left), 50u);
+  ASSERT_GT(drawnPixels(right), 20u);
+  EXPECT_GE(agreeingDrawnFraction(left, a, 32), 0.98) << "left half: the original's centre at 4x";
+  EXPECT_GE(agreeingDrawnFraction(right, b, 32), 0.98) << "right half: the copy's centre at 4x";
+  // Drawn columns of a half: [first, last].
+  auto columns = [](const test::Png& p) {
+    int first = -1, last = -1;
+    for (uint32_t x = 0; x < p.width; ++x)
+      for (uint32_t y = 0; y < p.height; ++y) {
+        const uint8_t* c = p.at(x, y);
+        if (c[0] + c[1] + c[2] <= 30) continue;
+        if (first < 0) first = int(x);
+        last = int(x);
+      }
+    return std::pair<int, int>{first, last};
+  };
+  const auto [l0, l1] = columns(left);
+  const auto [r0, r1] = columns(right);
+  EXPECT_GT(l0, 0) << "the original reaches its half's left edge";
+  EXPECT_LT(l1, 63) << "the original reaches its half's right edge";
+  EXPECT_NEAR(double(r1 - r0 + 1), double(l1 - l0 + 1) / 2, 2.0) << "one scale in both halves";
 }
 
 TEST_F(GpuViewerBundling, aSaveToAnExistingFileOrWithoutAModelIsAMessage) {

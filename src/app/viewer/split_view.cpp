@@ -8,21 +8,43 @@
 
 namespace fibscope {
 
-Camera splitHalfCamera(const Camera& camera, bool right) {
+namespace {
+
+double radiusOf(const Bounds& b) {
+  double d2 = 0;
+  for (int k = 0; k < 3; ++k) d2 += (b.max[k] - b.min[k]) * (b.max[k] - b.min[k]);
+  return std::max(std::sqrt(d2) / 2, 1.0);  // 1 mm at least, as the orbit controller's
+}
+
+}  // namespace
+
+double splitDistanceFactor(const Bounds& framed, const Bounds& left, const Bounds& right) {
+  Bounds both;
+  for (int k = 0; k < 3; ++k) {
+    both.min[k] = std::min(left.min[k], right.min[k]);
+    both.max[k] = std::max(left.max[k], right.max[k]);
+  }
+  const double ratio = radiusOf(both) / radiusOf(framed);
+  return kSplitDistanceFactor * (std::isfinite(ratio) ? std::max(ratio, 1.0) : 1.0);
+}
+
+Camera splitHalfCamera(const Camera& camera, bool right, double distance_factor, const Bounds& shown) {
   Camera half = camera;
   const uint32_t left = splitLeftWidth(camera.width);
   half.width = std::max(1u, right ? camera.width - left : left);
-  double shift2 = 0;
+  double distance2 = 0;
   for (int k = 0; k < 3; ++k) {
     const double back = camera.eye[k] - camera.target[k];
-    half.eye[k] = camera.target[k] + kSplitDistanceFactor * back;
-    shift2 += back * back * (kSplitDistanceFactor - 1) * (kSplitDistanceFactor - 1);
+    half.eye[k] = camera.target[k] + distance_factor * back;
+    distance2 += back * back;
   }
   // Everything the full camera's planes enclosed lies that much farther now.
-  const double shift = std::sqrt(shift2);
+  const double distance = std::sqrt(distance2), shift = distance * (distance_factor - 1);
   half.near_mm += shift;
   half.far_mm += shift;
-  return half;
+  // And the union's box, which may reach beyond the box the camera was
+  // framed on.
+  return enclosingDepthRange(half, boundsCorners(shown));
 }
 
 void recordSplitCompose(VkCommandBuffer cmd, const gpu::Buffer& left, const gpu::Buffer& right,

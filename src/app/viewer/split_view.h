@@ -11,6 +11,12 @@
 // of the full-width frame the eye at twice the distance would give (x_half =
 // x_full - width / 4, pixel for pixel). The orbit controller is not touched:
 // turning the split off gives the same view back.
+//
+// The camera was framed on the models visible when the last one was added:
+// a bundled copy comes in alone (its original hidden), and is smaller than
+// its original, which would then be cut at the edges of its half. So the
+// eye goes back farther by the ratio of the two models' union to the framed
+// box (splitDistanceFactor), and both halves keep one scale.
 // Plain functions (STYLE.md rule 4).
 #pragma once
 
@@ -25,9 +31,17 @@ namespace fibscope {
 
 // The left half's width (the right one has the rest).
 inline uint32_t splitLeftWidth(uint32_t width) { return width / 2; }
-// The camera of the left (`right` false) or right half of `camera`'s image.
 inline constexpr double kSplitDistanceFactor = 2.0;
-Camera splitHalfCamera(const Camera& camera, bool right);
+// kSplitDistanceFactor times the ratio of the bounding spheres (half box
+// diagonals) of the union of `left` and `right` and of `framed`, when that
+// is above 1. Diagonals, not a snug fit along the view direction, so that
+// the scale stays put while the user orbits.
+double splitDistanceFactor(const Bounds& framed, const Bounds& left, const Bounds& right);
+// The camera of the left (`right` false) or right half of `camera`'s
+// image, its eye `distance_factor` times as far from the target; near and
+// far enclose both what the full camera's did and the box `shown` (the
+// union of the two models).
+Camera splitHalfCamera(const Camera& camera, bool right, double distance_factor, const Bounds& shown);
 
 // After both halves' frames were recorded (their shade passes wrote `left`
 // and `right`, RGBA8, top row first, splitLeftWidth(width) and the rest

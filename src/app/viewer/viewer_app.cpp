@@ -163,6 +163,12 @@ class ViewerApp {
   // The camera on the union of the visible models (every model when none
   // is visible), and the scalar range on their fiber lengths.
   void frameVisibleModels();
+  // frameVisibleModels when a model was added or closed since the last.
+  void frameIfModelsChanged();
+  // The orbit controller's camera, its near and far widened to the visible
+  // models and the anatomy (show and hide keep the framing: a model shown
+  // later may reach beyond the box the camera was framed on).
+  Camera viewCamera(uint32_t width, uint32_t height) const;
   void fitScalarRange();
   // What the next frame draws (between frames: the scene's fiber lengths
   // may be copied, the dissection's filter evaluated; `filter_now`: without
@@ -240,6 +246,7 @@ class ViewerApp {
   // renderer_'s colour buffer; both made at the first coarse frame.
   std::unique_ptr<FrameRenderer> coarse_renderer_;
   std::unique_ptr<FrameRenderer> split_renderers_[2];  // the split view's halves (left, right)
+  double split_reported_factor_ = 0;                    // the halves' distance factor last printed
   bool split_recorded_ = false;                        // the frame in flight is a split one
   UpscalePass upscale_;
   bool upscale_ready_ = false;
@@ -499,6 +506,10 @@ void ViewerApp::pollLoads() {
     state_.load_failures.push_back(LoadFailure{event.path, event.error});
     std::fprintf(stderr, "fibscope view: %s\n", event.error.c_str());
   }
+  // Framed now, not by the next drawFrame: this frame's script steps (after
+  // a wait-loaded or wait-bundle) and input see the new framing, and the
+  // framing sees the bundled copy's source hidden.
+  frameIfModelsChanged();
   state_.loading.clear();
   const size_t pending = loader_->pending();
   for (const LoadProgress& p : loader_->progress()) {
@@ -560,7 +571,7 @@ void ViewerApp::addModel(LoadEvent& event) {
   model->data = std::move(event.model);
   state_.models.push_back(info);
   scenes_.push_back(std::move(model));
-  state_.active_model = int(state_.models.size()) - 1;  // the camera framed on every model by the next drawFrame
+  state_.active_model = int(state_.models.size()) - 1;  // framed at the end of pollLoads
   scene_lengths_->invalidate();
 
   uint64_t frames_meanwhile = 0;
@@ -611,6 +622,12 @@ void ViewerApp::closeModel(int model) {
   if (was_active && !state_.models.empty()) state_.active_model = std::min(model, int(state_.models.size()) - 1);
 }
 
+void ViewerApp::frameIfModelsChanged() {
+  std::vector<uint64_t> ids;
+  for (const auto& m : scenes_) ids.push_back(m->id);
+  if (ids != framed_ids_) frameVisibleModels();
+}
+
 void ViewerApp::frameVisibleModels() {
   framed_ids_.clear();
   for (const auto& m : scenes_) framed_ids_.push_back(m->id);
@@ -633,6 +650,14 @@ void ViewerApp::frameVisibleModels() {
     controller_.frame(bounds, sample);
     state_.scene_bounds = bounds;
   }
+}
+
+Camera ViewerApp::viewCamera(uint32_t width, uint32_t height) const {
+  std::vector<Vec3d> corners;
+  for (size_t i = 0; i < scenes_.size(); ++i)
+    if (state_.models[i].visible)
+      for (const Vec3d& c : boundsCorners(scenes_[i]->data->bounds)) corners.push_back(c);
+  return anatomy_.inView(enclosingDepthRange(controller_.camera(width, height), corners));
 }
 
 void ViewerApp::fitScalarRange() {
@@ -793,8 +818,24 @@ FrameScene ViewerApp::modelScene(int model) {
 
 void ViewerApp::recordSplit(VkCommandBuffer cmd, const Camera& camera, const gpu::Buffer& out) {
   const int models[2] = {state_.split.left, state_.split.right};
+  const Bounds& left = scenes_[size_t(models[0])]->data->bounds;
+  const Bounds& right = scenes_[size_t(models[1])]->data->bounds;
+  Bounds shown;
+  for (int k = 0; k < 3; ++k)
+    shown.min[k] = std::min(left.min[k], right.min[k]), shown.max[k] = std::max(left.max[k], right.max[k]);
+  const double factor = splitDistanceFactor(controller_.bounds(), left, right);
+  if (factor != split_reported_factor_) {
+    // The halves' scale as drawn (a model added this frame is framed before
+    // its first split frame), for the record and the tests.
+    split_reported_factor_ = factor;
+    char line[160];
+    std::snprintf(line, sizeof line, "split-view %d %d: each half's eye %.4fx as far as the view's", models[0],
+                  models[1], factor);
+    state_.status = line;
+    std::fprintf(stderr, "fibscope view: %s\n", line);
+  }
   for (const int k : {0, 1}) {
-    const Camera half = splitHalfCamera(camera, k == 1);
+    const Camera half = splitHalfCamera(camera, k == 1, factor, shown);
     std::unique_ptr<FrameRenderer>& r = split_renderers_[k];
     if (!r) r = std::make_unique<FrameRenderer>(*context_, half.width, half.height, frameStages());
     else if (r->targets().width != half.width || r->targets().height != half.height) r->resize(half.width, half.height);
@@ -968,6 +1009,7 @@ void ViewerApp::apply(const ViewerAction& action) {
             std::fprintf(stderr, "fibscope view: %s\n", state_.status.c_str());
           } else {
             state_.split = {a.on, a.on ? a.left : -1, a.on ? a.right : -1};
+            split_reported_factor_ = 0;  // the next split frame reports its scale
           }
         } else if constexpr (std::is_same_v<A, SaveModelAction>) {
           saveModel(a);
@@ -1262,7 +1304,7 @@ void ViewerApp::takeScreenshot(const ScreenshotAction& shot) {
     if (!shot_renderer_)
       shot_renderer_ = std::make_unique<FrameRenderer>(*context_, shot.width, shot.height, frameStages());
     shot_renderer_->resize(shot.width, shot.height);
-    const Camera camera = anatomy_.inView(controller_.camera(shot.width, shot.height));
+    const Camera camera = viewCamera(shot.width, shot.height);
     if (splitActive()) {
       // The split view at the shot's size, composed in the shot's colour buffer.
       gpu::submitOnce(*context_, [&](VkCommandBuffer cmd) { recordSplit(cmd, camera, shot_renderer_->targets().color); });
@@ -1569,16 +1611,14 @@ bool ViewerApp::drawFrame(uint32_t width, uint32_t height, double dt) {
   // A model added or closed: the camera frames every visible model. Show,
   // hide and switching the active model keep the view (the user may hide a
   // model to look inside another).
-  std::vector<uint64_t> ids, visible_ids;
-  for (size_t i = 0; i < scenes_.size(); ++i) {
-    ids.push_back(scenes_[i]->id);
+  frameIfModelsChanged();
+  std::vector<uint64_t> visible_ids;
+  for (size_t i = 0; i < scenes_.size(); ++i)
     if (state_.models[i].visible) visible_ids.push_back(scenes_[i]->id);
-  }
-  if (ids != framed_ids_) frameVisibleModels();
   if (visible_ids != scalar_range_ids_) fitScalarRange();
   ensureRawFor(state_.active_model);
   if (state_.fov_deg != controller_.fovY()) controller_.setFovY(state_.fov_deg);
-  const Camera camera = anatomy_.inView(controller_.camera(width, height));
+  const Camera camera = viewCamera(width, height);
   const FrameScene scene = currentScene();
   syncSelection(scene);  // the highlight's bits for this frame (nothing in flight now)
   syncTubes(scene);
