@@ -127,18 +127,10 @@ void GpuBundler::load(const Tractogram& t, const BundleSetup& setup, const Bundl
   gpu::uploadToBuffer(context_, point_offsets_, point_offsets.data(), point_offsets.size() * 4);
   gpu::uploadToBuffer(context_, sample_offsets_, setup.sample_offsets.data(), setup.sample_offsets.size() * 4);
   if (!sample_fiber.empty()) gpu::uploadToBuffer(context_, sample_fiber_, sample_fiber.data(), sample_fiber.size() * 4);
-  for (size_t c = 0; c + 1 < chunks_.size(); ++c) {
-    shader::BundleFiberPush push = chunkPush(t, c);
+  forEachChunk(t, nullptr, [&](VkCommandBuffer cmd, shader::BundleFiberPush push) {
     push.samples = original_.address;
-    const uint64_t first = t.offsets[chunks_[c]], count = t.offsets[chunks_[c + 1]] - first;
-    gpu::uploadToBuffer(context_, points_, t.positions.data() + 3 * first, count * 12);
-    gpu::submitOnce(context_, [&](VkCommandBuffer cmd) {
-      gpu::resetGpuTimer(cmd, timer_);
-      afterEarlierWork(cmd);
-      recordBundleResample(cmd, context_, pipelines_, push, &timer_);
-    });
-    addTimes();
-  }
+    recordBundleResample(cmd, context_, pipelines_, push, &timer_);
+  });
   gpu::submitOnce(context_, [&](VkCommandBuffer cmd) {
     gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                        VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
@@ -234,24 +226,31 @@ std::vector<float> GpuBundler::finish(const Tractogram& t) {
   });
   addTimes();
   std::vector<float> out(points_count_ * 3);
-  for (size_t c = 0; c + 1 < chunks_.size(); ++c) {
-    shader::BundleFiberPush map = chunkPush(t, c);
+  forEachChunk(t, out.data(), [&](VkCommandBuffer cmd, shader::BundleFiberPush map) {
     map.samples = scratch_.address;
     map.originals = original_.address;
+    recordBundleMapBack(cmd, context_, pipelines_, map, &timer_);
+  });
+  return out;
+}
+
+void GpuBundler::forEachChunk(const Tractogram& t, float* positions_out,
+                              const std::function<void(VkCommandBuffer, shader::BundleFiberPush)>& record) {
+  for (size_t c = 0; c + 1 < chunks_.size(); ++c) {
     const uint64_t first = t.offsets[chunks_[c]], count = t.offsets[chunks_[c + 1]] - first;
     gpu::uploadToBuffer(context_, points_, t.positions.data() + 3 * first, count * 12);
     gpu::submitOnce(context_, [&](VkCommandBuffer cmd) {
       gpu::resetGpuTimer(cmd, timer_);
       afterEarlierWork(cmd);
-      recordBundleMapBack(cmd, context_, pipelines_, map, &timer_);
-      gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                         VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT | VK_PIPELINE_STAGE_2_HOST_BIT,
-                         VK_ACCESS_2_TRANSFER_READ_BIT | VK_ACCESS_2_HOST_READ_BIT);
+      record(cmd, chunkPush(t, c));
+      if (positions_out)
+        gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                           VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT | VK_PIPELINE_STAGE_2_HOST_BIT,
+                           VK_ACCESS_2_TRANSFER_READ_BIT | VK_ACCESS_2_HOST_READ_BIT);
     });
     addTimes();
-    gpu::downloadFromBuffer(context_, points_, out.data() + 3 * first, count * 12);
+    if (positions_out) gpu::downloadFromBuffer(context_, points_, positions_out + 3 * first, count * 12);
   }
-  return out;
 }
 
 void GpuBundler::addTimes() {

@@ -83,6 +83,12 @@ class GpuBundler {
   // The first fiber of each chunk, then the fiber count.
   std::vector<uint32_t> planChunks(const Tractogram& tractogram, uint64_t* most_points) const;
   shader::BundleFiberPush chunkPush(const Tractogram& tractogram, size_t chunk) const;
+  // Each chunk's points uploaded into points_, then `record` (given the
+  // chunk's push) submitted after the earlier work; with `positions_out`
+  // (3 floats a point of the whole tractogram) points_ is read back into it
+  // after each chunk (the map-back writes the moved points there in place).
+  void forEachChunk(const Tractogram& tractogram, float* positions_out,
+                    const std::function<void(VkCommandBuffer, shader::BundleFiberPush)>& record);
   const gpu::VulkanContext& context_;
   GpuBundlerOptions options_;
   BundlePipelines pipelines_;
