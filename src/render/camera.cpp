@@ -141,7 +141,7 @@ Camera fitCamera(const Bounds& bounds, Vec3d direction, Vec3d up, uint32_t width
   const Vec3d centre = {(bounds.min[0] + bounds.max[0]) / 2, (bounds.min[1] + bounds.max[1]) / 2,
                         (bounds.min[2] + bounds.max[2]) / 2};
   // A box of size 0 still gets a 1 mm sphere, so the matrices stay valid.
-  const double radius = std::max(glm::length(vec(bounds.max) - vec(bounds.min)) / 2, 1.0);
+  const double radius = boundingRadius(bounds);
   const double half_fov_y = radians(fov_y_deg) / 2;
   const double half_fov_x = std::atan(std::tan(half_fov_y) * double(width) / double(height));
   // A sphere of radius r at distance d fills a cone of half-angle asin(r / d).
@@ -236,6 +236,16 @@ std::array<Vec3d, 8> boundsCorners(const Bounds& bounds) {
   for (int c = 0; c < 8; ++c)
     for (int k = 0; k < 3; ++k) corners[size_t(c)][size_t(k)] = (c >> k) & 1 ? bounds.max[k] : bounds.min[k];
   return corners;
+}
+
+Bounds boundsUnion(const Bounds& a, const Bounds& b) {
+  Bounds u;
+  for (int k = 0; k < 3; ++k) u.min[k] = std::min(a.min[k], b.min[k]), u.max[k] = std::max(a.max[k], b.max[k]);
+  return u;
+}
+
+double boundingRadius(const Bounds& bounds) {
+  return std::max(glm::length(vec(bounds.max) - vec(bounds.min)) / 2, 1.0);
 }
 
 Camera enclosingDepthRange(Camera camera, std::span<const Vec3d> points) {

@@ -71,6 +71,11 @@ struct Bounds {
 Bounds tractogramBounds(const Tractogram& tractogram);
 // The box's 8 corners (bit k of the index picks max on axis k).
 std::array<Vec3d, 8> boundsCorners(const Bounds& bounds);
+// The smallest box holding both.
+Bounds boundsUnion(const Bounds& a, const Bounds& b);
+// Radius of the box's bounding sphere (half its diagonal), at least 1 mm:
+// what fitCamera frames.
+double boundingRadius(const Bounds& bounds);
 
 // The camera with near and far widened (never narrowed) so that the
 // points in front of the eye lie between them with a 1 % margin (near not

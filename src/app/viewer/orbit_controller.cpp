@@ -20,15 +20,6 @@ Quat unitOrIdentity(const Quat& q) {
   return n > 0 && std::isfinite(n) ? q / n : Quat{};
 }
 
-std::array<Vec3d, 8> cornersOf(const Bounds& b) {
-  std::array<Vec3d, 8> corners;
-  for (int i = 0; i < 8; ++i)
-    corners[i] = {(i & 1) ? b.max[0] : b.min[0], (i & 2) ? b.max[1] : b.min[1], (i & 4) ? b.max[2] : b.min[2]};
-  return corners;
-}
-// Radius of the box's bounding sphere, at least 1 mm (fitCamera's rule).
-double radiusOf(const Bounds& b) { return std::max(glm::length(vec(b.max) - vec(b.min)) / 2, 1.0); }
-
 // The orientation of a camera whose eye lies on `back` from the target with
 // `up` (projected orthogonal to back), as camera.h's viewMatrix builds it:
 // the rotation whose columns are its right, up and back axes.
@@ -62,7 +53,7 @@ OrbitController::State OrbitController::defaultState() const {
   };
   Camera fitted;
   if (sample_.empty()) {
-    const std::array<Vec3d, 8> corners = cornersOf(bounds_);
+    const std::array<Vec3d, 8> corners = boundsCorners(bounds_);
     fitted = snugCamera(corners, make);
   } else {
     fitted = snugCamera(sample_, make);
@@ -122,7 +113,7 @@ void OrbitController::pan(double dx_px, double dy_px) {
   Vec3d target = array(vec(goal_.target) + right * (-dx_px * mm_per_px) + up * (dy_px * mm_per_px));
   // Keep the target within the box grown by its diagonal either side, so the
   // model cannot be lost far off screen.
-  const double slack = 2 * radiusOf(bounds_);
+  const double slack = 2 * boundingRadius(bounds_);
   for (int k = 0; k < 3; ++k) target[k] = std::clamp(target[k], bounds_.min[k] - slack, bounds_.max[k] + slack);
   goal_.target = target;
 }
@@ -196,12 +187,12 @@ Camera OrbitController::makeCamera(const State& state, uint32_t width, uint32_t 
   // anyway, and a tiny positive near keeps the matrices valid.
   const glm::dvec3 forward = -back;
   double min_depth = std::numeric_limits<double>::infinity(), max_depth = -min_depth;
-  for (const Vec3d& corner : cornersOf(bounds_)) {
+  for (const Vec3d& corner : boundsCorners(bounds_)) {
     const double depth = glm::dot(vec(corner) - vec(camera.eye), forward);
     min_depth = std::min(min_depth, depth);
     max_depth = std::max(max_depth, depth);
   }
-  const double margin = 0.01 * radiusOf(bounds_);
+  const double margin = 0.01 * boundingRadius(bounds_);
   camera.near_mm = std::max(min_depth - margin, 1e-4 * state.distance);
   camera.far_mm = std::max(max_depth + margin, camera.near_mm + state.distance);
   return camera;

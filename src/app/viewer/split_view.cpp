@@ -8,23 +8,8 @@
 
 namespace fibscope {
 
-namespace {
-
-double radiusOf(const Bounds& b) {
-  double d2 = 0;
-  for (int k = 0; k < 3; ++k) d2 += (b.max[k] - b.min[k]) * (b.max[k] - b.min[k]);
-  return std::max(std::sqrt(d2) / 2, 1.0);  // 1 mm at least, as the orbit controller's
-}
-
-}  // namespace
-
-double splitDistanceFactor(const Bounds& framed, const Bounds& left, const Bounds& right) {
-  Bounds both;
-  for (int k = 0; k < 3; ++k) {
-    both.min[k] = std::min(left.min[k], right.min[k]);
-    both.max[k] = std::max(left.max[k], right.max[k]);
-  }
-  const double ratio = radiusOf(both) / radiusOf(framed);
+double splitDistanceFactor(const Bounds& framed, const Bounds& shown) {
+  const double ratio = boundingRadius(shown) / boundingRadius(framed);
   return kSplitDistanceFactor * (std::isfinite(ratio) ? std::max(ratio, 1.0) : 1.0);
 }
 

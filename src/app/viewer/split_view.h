@@ -33,10 +33,10 @@ namespace fibscope {
 inline uint32_t splitLeftWidth(uint32_t width) { return width / 2; }
 inline constexpr double kSplitDistanceFactor = 2.0;
 // kSplitDistanceFactor times the ratio of the bounding spheres (half box
-// diagonals) of the union of `left` and `right` and of `framed`, when that
-// is above 1. Diagonals, not a snug fit along the view direction, so that
+// diagonals) of `shown` (the union of the two models) and of `framed`,
+// when that is above 1. Diagonals, not a snug fit along the view direction, so that
 // the scale stays put while the user orbits.
-double splitDistanceFactor(const Bounds& framed, const Bounds& left, const Bounds& right);
+double splitDistanceFactor(const Bounds& framed, const Bounds& shown);
 // The camera of the left (`right` false) or right half of `camera`'s
 // image, its eye `distance_factor` times as far from the target; near and
 // far enclose both what the full camera's did and the box `shown` (the

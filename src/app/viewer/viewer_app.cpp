@@ -639,10 +639,7 @@ void ViewerApp::frameVisibleModels() {
   for (size_t i = 0; i < scenes_.size(); ++i) {
     if (any_visible && !state_.models[i].visible) continue;
     const ModelData& data = *scenes_[i]->data;
-    for (int k = 0; k < 3; ++k) {
-      bounds.min[k] = first ? data.bounds.min[k] : std::min(bounds.min[k], data.bounds.min[k]);
-      bounds.max[k] = first ? data.bounds.max[k] : std::max(bounds.max[k], data.bounds.max[k]);
-    }
+    bounds = first ? data.bounds : boundsUnion(bounds, data.bounds);
     first = false;
     sample.insert(sample.end(), data.sample.begin(), data.sample.end());
   }
@@ -818,12 +815,8 @@ FrameScene ViewerApp::modelScene(int model) {
 
 void ViewerApp::recordSplit(VkCommandBuffer cmd, const Camera& camera, const gpu::Buffer& out) {
   const int models[2] = {state_.split.left, state_.split.right};
-  const Bounds& left = scenes_[size_t(models[0])]->data->bounds;
-  const Bounds& right = scenes_[size_t(models[1])]->data->bounds;
-  Bounds shown;
-  for (int k = 0; k < 3; ++k)
-    shown.min[k] = std::min(left.min[k], right.min[k]), shown.max[k] = std::max(left.max[k], right.max[k]);
-  const double factor = splitDistanceFactor(controller_.bounds(), left, right);
+  const Bounds shown = boundsUnion(scenes_[size_t(models[0])]->data->bounds, scenes_[size_t(models[1])]->data->bounds);
+  const double factor = splitDistanceFactor(controller_.bounds(), shown);
   if (factor != split_reported_factor_) {
     // The halves' scale as drawn (a model added this frame is framed before
     // its first split frame), for the record and the tests.
