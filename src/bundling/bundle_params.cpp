@@ -33,6 +33,10 @@ std::string bundleParamsProblem(const BundleParams& p) {
     return outOfRange("smoothing length", p.smoothing_length, "0 to 100 radii");
   if (!(p.relaxation >= 0 && p.relaxation <= 1)) return outOfRange("relaxation", p.relaxation, "in [0, 1]");
   if (!(p.anisotropy >= 0.05 && p.anisotropy <= 1)) return outOfRange("anisotropy", p.anisotropy, "in [0.05, 1]");
+  if (p.structure_power < 1 || p.structure_power > 8)
+    return outOfRange("structure power", p.structure_power, "1 to 8");
+  if (!(p.structure_scale >= 0.1 && p.structure_scale <= 2))
+    return outOfRange("structure scale", p.structure_scale, "in [0.1, 2] radii");
   return "";
 }
 

@@ -11,7 +11,7 @@ namespace fibscope {
 
 enum class BundleMode : uint8_t {
   Isotropic,    // the paper's density: every sample splats the same kernel
-  Anisotropic,  // structure-aware (after Bouma, Hurter, Telea): a kernel elongated along each sample's fiber
+  Anisotropic,  // after Bouma, Hurter, Telea: a kernel elongated along each sample's fiber
 };
 
 struct BundleParams {
@@ -29,6 +29,12 @@ struct BundleParams {
   double relaxation = 0.85;       // alpha: 1 keeps the bundled positions, 0 the original ones
   bool anchor_ends = false;       // true: fiber end points do not move
   double anisotropy = 0.5;        // anisotropic mode: the kernel's radius across the fiber / along it
+  // Structure-aware advection (either mode; docs/BUNDLING.md): the step is
+  // the gradient filtered by the density's structure tensor, so a sheet of
+  // fibers contracts across its plane and does not break into strands.
+  bool structure_aware = false;
+  uint32_t structure_power = 2;   // the filter (J / lambda1)^power: higher selects the dominant direction harder
+  double structure_scale = 1.0;   // the tensor's cells: structure_scale x the first R voxels a side (at least 2)
 };
 
 // "" when the parameters are usable, else one line naming the parameter,

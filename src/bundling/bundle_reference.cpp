@@ -164,23 +164,130 @@ std::vector<glm::dvec3> gradientReference(const std::vector<double>& density, co
   return out;
 }
 
-glm::dvec3 interpolateGradient(const std::vector<glm::dvec3>& gradient, const BundleGrid& g, glm::dvec3 p) {
+namespace {
+
+// Trilinear interpolation of a per-voxel field between voxel centres,
+// clamped at the faces (the advection's gradient and structure tensor).
+template <typename T>
+T trilinear(const std::vector<T>& field, const BundleGrid& g, glm::dvec3 p) {
   const glm::dvec3 size(g.size);
   const glm::dvec3 q = (p - g.origin) / g.voxel - 0.5;
   const glm::dvec3 i0 = glm::clamp(glm::floor(q), glm::dvec3(0.0), glm::max(size - 2.0, glm::dvec3(0.0)));
   const glm::dvec3 t = glm::clamp(q - i0, glm::dvec3(0.0), glm::dvec3(1.0));
   const glm::uvec3 a(i0), b(glm::min(i0 + 1.0, size - 1.0));
-  auto at = [&](uint32_t x, uint32_t y, uint32_t z) { return gradient[g.index(x, y, z)]; };
-  const glm::dvec3 x00 = glm::mix(at(a.x, a.y, a.z), at(b.x, a.y, a.z), t.x);
-  const glm::dvec3 x10 = glm::mix(at(a.x, b.y, a.z), at(b.x, b.y, a.z), t.x);
-  const glm::dvec3 x01 = glm::mix(at(a.x, a.y, b.z), at(b.x, a.y, b.z), t.x);
-  const glm::dvec3 x11 = glm::mix(at(a.x, b.y, b.z), at(b.x, b.y, b.z), t.x);
-  return glm::mix(glm::mix(x00, x10, t.y), glm::mix(x01, x11, t.y), t.z);
+  auto at = [&](uint32_t x, uint32_t y, uint32_t z) { return field[g.index(x, y, z)]; };
+  auto mix = [](const T& u, const T& v, double s) { return u * (1.0 - s) + v * s; };
+  const T x00 = mix(at(a.x, a.y, a.z), at(b.x, a.y, a.z), t.x);
+  const T x10 = mix(at(a.x, b.y, a.z), at(b.x, b.y, a.z), t.x);
+  const T x01 = mix(at(a.x, a.y, b.z), at(b.x, a.y, b.z), t.x);
+  const T x11 = mix(at(a.x, b.y, b.z), at(b.x, b.y, b.z), t.x);
+  return mix(mix(x00, x10, t.y), mix(x01, x11, t.y), t.z);
+}
+
+}  // namespace
+
+glm::dvec3 interpolateGradient(const std::vector<glm::dvec3>& gradient, const BundleGrid& g, glm::dvec3 p) {
+  return trilinear(gradient, g, p);
+}
+
+BundleTensors structureTensorReference(const std::vector<double>& density, const BundleGrid& g, uint32_t cell) {
+  const BundleGrid cells = bundleStructureGrid(g, cell);
+  // 1. The density at the tensor's scale: its mean over each cell.
+  std::vector<double> mean(cells.voxelCount(), 0.0);
+  for (uint32_t cz = 0; cz < cells.size.z; ++cz)
+    for (uint32_t cy = 0; cy < cells.size.y; ++cy)
+      for (uint32_t cx = 0; cx < cells.size.x; ++cx) {
+        const glm::uvec3 lo = glm::uvec3(cx, cy, cz) * cell, hi = glm::min(lo + cell, g.size);
+        double sum = 0;
+        for (uint32_t z = lo.z; z < hi.z; ++z)
+          for (uint32_t y = lo.y; y < hi.y; ++y)
+            for (uint32_t x = lo.x; x < hi.x; ++x) sum += density[g.index(x, y, z)];
+        const glm::uvec3 n = hi - lo;
+        mean[cells.index(cx, cy, cz)] = sum / double(n.x * n.y * n.z);
+      }
+  // 2. Its gradient between cells (central differences, one-sided at the
+  // faces, as gradientReference on the cell grid).
+  const std::vector<glm::dvec3> grad = gradientReference(mean, cells);
+  // 3. The tensor: the mean of grad grad^T over the cell and its (up to 26)
+  // neighbours, so a sheet's middle cell, where the gradient changes sign,
+  // still sees the sheet's normal.
+  BundleTensors out(cells.voxelCount(), glm::dmat3(0.0));
+  for (uint32_t cz = 0; cz < cells.size.z; ++cz)
+    for (uint32_t cy = 0; cy < cells.size.y; ++cy)
+      for (uint32_t cx = 0; cx < cells.size.x; ++cx) {
+        const glm::uvec3 c(cx, cy, cz);
+        const glm::uvec3 lo = glm::max(c, glm::uvec3(1)) - 1u, hi = glm::min(c + 2u, cells.size);
+        glm::dmat3 sum(0.0);
+        for (uint32_t z = lo.z; z < hi.z; ++z)
+          for (uint32_t y = lo.y; y < hi.y; ++y)
+            for (uint32_t x = lo.x; x < hi.x; ++x) {
+              const glm::dvec3 v = grad[cells.index(x, y, z)];
+              sum += glm::outerProduct(v, v);
+            }
+        const glm::uvec3 n = hi - lo;
+        out[cells.index(cx, cy, cz)] = sum / double(n.x * n.y * n.z);
+      }
+  return out;
+}
+
+glm::dmat3 interpolateTensor(const BundleTensors& tensors, const BundleGrid& cells, glm::dvec3 p) {
+  return trilinear(tensors, cells, p);
+}
+
+void symmetricEigenReference(const glm::dmat3& m, glm::dvec3* values, glm::dmat3* vectors) {
+  double a[3][3], v[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) a[i][j] = 0.5 * (m[j][i] + m[i][j]);
+  for (int sweep = 0; sweep < 64; ++sweep) {
+    const double off = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
+    const double diag = a[0][0] * a[0][0] + a[1][1] * a[1][1] + a[2][2] * a[2][2];
+    if (!(off > 1e-32 * diag)) break;
+    for (int p = 0; p < 2; ++p)
+      for (int q = p + 1; q < 3; ++q) {
+        if (a[p][q] == 0) continue;
+        const double theta = (a[q][q] - a[p][p]) / (2 * a[p][q]);
+        const double t = (theta >= 0 ? 1.0 : -1.0) / (std::abs(theta) + std::sqrt(theta * theta + 1));
+        const double c = 1 / std::sqrt(t * t + 1), s = t * c;
+        for (int k = 0; k < 3; ++k) {  // A P
+          const double kp = a[k][p], kq = a[k][q];
+          a[k][p] = c * kp - s * kq;
+          a[k][q] = s * kp + c * kq;
+        }
+        for (int k = 0; k < 3; ++k) {  // P^T (A P)
+          const double pk = a[p][k], qk = a[q][k];
+          a[p][k] = c * pk - s * qk;
+          a[q][k] = s * pk + c * qk;
+        }
+        for (int k = 0; k < 3; ++k) {  // V P
+          const double kp = v[k][p], kq = v[k][q];
+          v[k][p] = c * kp - s * kq;
+          v[k][q] = s * kp + c * kq;
+        }
+      }
+  }
+  int order[3] = {0, 1, 2};
+  std::sort(order, order + 3, [&](int i, int j) { return a[i][i] > a[j][j]; });
+  for (int k = 0; k < 3; ++k) {
+    (*values)[k] = a[order[k]][order[k]];
+    (*vectors)[k] = glm::dvec3(v[0][order[k]], v[1][order[k]], v[2][order[k]]);
+  }
+}
+
+glm::dmat3 structureFilterReference(const glm::dmat3& tensor, uint32_t power) {
+  glm::dvec3 lambda;
+  glm::dmat3 e;
+  symmetricEigenReference(tensor, &lambda, &e);
+  const double floor = double(shader::kBundleMinGradient) * double(shader::kBundleMinGradient);
+  if (!(lambda[0] > floor)) return glm::dmat3(1.0);
+  glm::dmat3 out(0.0);
+  for (int k = 0; k < 3; ++k)
+    out += std::pow(std::max(lambda[k], 0.0) / lambda[0], double(power)) * glm::outerProduct(e[k], e[k]);
+  return out;
 }
 
 BundleSamples advectReference(const BundleSamples& samples, const std::vector<uint32_t>& offsets,
                               const std::vector<glm::dvec3>& gradient, const BundleGrid& grid, double step_mm,
-                              bool anchor_ends) {
+                              bool anchor_ends, const BundleStructureField* structure) {
   BundleSamples out = samples;
   for (size_t i = 0; i < samples.size(); ++i) {
     const uint32_t f = sampleFiber(offsets, i);
@@ -192,7 +299,12 @@ BundleSamples advectReference(const BundleSamples& samples, const std::vector<ui
     const double glen = glm::length(g), alen = glm::length(along);
     if (!(glen > double(shader::kBundleMinGradient)) || !(alen > 0)) continue;
     const glm::dvec3 d = along / alen;
-    out[i] = samples[i] + (g - d * glm::dot(d, g)) * (step_mm / glen);
+    const glm::dvec3 m =
+        structure ? structureFilterReference(interpolateTensor(*structure->tensors, structure->cells, samples[i]),
+                                             structure->power) *
+                        g
+                  : g;
+    out[i] = samples[i] + (m - d * glm::dot(d, m)) * (step_mm / glen);
   }
   return out;
 }
@@ -253,8 +365,16 @@ BundleSamples iterateReference(const BundleSamples& samples, const BundleSetup& 
           ? splatReference(samples, setup.sample_offsets, grid, radius, radius * params.anisotropy)
           : densitySeparableReference(countReference(samples, grid), grid, radius);
   const std::vector<glm::dvec3> gradient = gradientReference(density, grid);
-  const BundleSamples advected = advectReference(samples, setup.sample_offsets, gradient, grid,
-                                                 bundleAdvectionStep(params, setup, radius), params.anchor_ends);
+  BundleTensors tensors;
+  BundleStructureField structure;
+  if (params.structure_aware) {
+    const uint32_t cell = bundleStructureCell(params);
+    tensors = structureTensorReference(density, grid, cell);
+    structure = {&tensors, bundleStructureGrid(grid, cell), params.structure_power};
+  }
+  const BundleSamples advected =
+      advectReference(samples, setup.sample_offsets, gradient, grid, bundleAdvectionStep(params, setup, radius),
+                      params.anchor_ends, params.structure_aware ? &structure : nullptr);
   return smoothReference(advected, setup.sample_offsets, params.smoothing, bundleSmoothingWindow(params, setup, radius),
                          params.anchor_ends);
 }

@@ -17,6 +17,7 @@
 namespace fibscope {
 
 using BundleSamples = std::vector<glm::dvec3>;  // setup.sample_offsets order
+using BundleTensors = std::vector<glm::dmat3>;   // per cell of a structure grid
 
 // Resample: fiber f's n samples at arc lengths k len / (n - 1), the first
 // and the last its end points (n = 1: its first point).
@@ -50,10 +51,36 @@ std::vector<glm::dvec3> gradientReference(const std::vector<double>& density, co
 // The gradient at p, trilinear between voxel centres (clamped at the faces).
 glm::dvec3 interpolateGradient(const std::vector<glm::dvec3>& gradient, const BundleGrid& grid, glm::dvec3 p);
 
+// Structure tensor, per cell of `cell` voxels a side (bundleStructureGrid):
+// the density averaged over each cell (the tensor's scale, coarse enough
+// that the ripple between neighbouring fibers is gone), its gradient
+// between cells, and the mean of grad grad^T over the cell and its
+// neighbours (the integration scale).
+BundleTensors structureTensorReference(const std::vector<double>& density, const BundleGrid& grid, uint32_t cell);
+// The tensor at p, trilinear between cell centres (clamped at the faces).
+glm::dmat3 interpolateTensor(const BundleTensors& tensors, const BundleGrid& cells, glm::dvec3 p);
+// Eigenvalues (descending) and unit eigenvectors (the columns, in the same
+// order) of a symmetric matrix, by cyclic Jacobi rotations.
+void symmetricEigenReference(const glm::dmat3& m, glm::dvec3* values, glm::dmat3* vectors);
+// The structure filter sum_k (lambda_k / lambda_1)^power e_k e_k^T from the
+// eigen decomposition (the GPU takes (J / lambda_1)^power by products: the
+// same matrix); the identity where lambda_1 <= kBundleMinGradient^2.
+glm::dmat3 structureFilterReference(const glm::dmat3& tensor, uint32_t power);
+
+// What structure-aware advection reads: the tensors, their grid, the power.
+struct BundleStructureField {
+  const BundleTensors* tensors = nullptr;
+  BundleGrid cells;
+  uint32_t power = 2;
+};
+
 // Constrained advection: p += step (g - d (d . g)) / |g| (step = R h mm).
+// With `structure`: g in that formula's numerator becomes M g, M the
+// structure filter of the tensor at p (|M g| <= |g|, so the step stays at
+// most `step` long and orthogonal to the fiber).
 BundleSamples advectReference(const BundleSamples& samples, const std::vector<uint32_t>& sample_offsets,
                               const std::vector<glm::dvec3>& gradient, const BundleGrid& grid, double step_mm,
-                              bool anchor_ends);
+                              bool anchor_ends, const BundleStructureField* structure = nullptr);
 // Smoothing: p' = (1 - phi) p + phi mean(p_j, |j - i| <= m), m = min(window,
 // i - s0, s1 - 1 - i): symmetric near the ends, which only advection moves.
 BundleSamples smoothReference(const BundleSamples& samples, const std::vector<uint32_t>& sample_offsets, double phi,
@@ -67,7 +94,7 @@ std::vector<float> mapBackReference(const Tractogram& tractogram, const BundleSe
                                     const BundleSamples& original, const BundleSamples& bundled);
 
 // One iteration at kernel radius `radius` (voxels): count, density,
-// gradient, advection, smoothing.
+// gradient, (structure tensor,) advection, smoothing.
 BundleSamples iterateReference(const BundleSamples& samples, const BundleSetup& setup, const BundleParams& params,
                                double radius);
 // A whole run: the bundled positions of every point of `tractogram`.

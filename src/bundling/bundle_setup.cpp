@@ -86,6 +86,18 @@ uint32_t bundleSmoothingWindow(const BundleParams& params, const BundleSetup& se
   return uint32_t(std::clamp(k, 1.0, 1e6));
 }
 
+uint32_t bundleStructureCell(const BundleParams& params) {
+  return uint32_t(std::max(2.0, std::round(params.structure_scale * params.radius)));
+}
+
+BundleGrid bundleStructureGrid(const BundleGrid& grid, uint32_t cell) {
+  BundleGrid cells;
+  cells.origin = grid.origin;
+  cells.voxel = grid.voxel * cell;
+  cells.size = (grid.size + (cell - 1)) / cell;
+  return cells;
+}
+
 shader::BundleGridBlock bundleGridBlock(const BundleGrid& grid) {
   shader::BundleGridBlock b{};
   b.origin_x = float(grid.origin.x);

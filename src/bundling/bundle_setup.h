@@ -52,6 +52,15 @@ double bundleAdvectionStep(const BundleParams& params, const BundleSetup& setup,
 // when smoothing_length > 0.
 uint32_t bundleSmoothingWindow(const BundleParams& params, const BundleSetup& setup, double radius);
 
+// Structure-aware advection: the structure tensor is kept per cell of
+// bundleStructureCell voxels a side, max(2, round(structure_scale x the
+// first R)), fixed for the run (24 B of tensor and 4 B of mean density a
+// cell: at most 3.5 B a voxel).
+// Its grid: the voxel grid's origin, cells of cell x voxel mm, ceil(size /
+// cell) a side (the last cell of an axis may hold fewer voxels).
+uint32_t bundleStructureCell(const BundleParams& params);
+BundleGrid bundleStructureGrid(const BundleGrid& grid, uint32_t cell);
+
 // The grid as the shaders see it.
 shader::BundleGridBlock bundleGridBlock(const BundleGrid& grid);
 
