@@ -56,4 +56,29 @@ vec3 bundleGradientAt(BundleGridBlock g, uint64_t density, uint is_count, float 
               bundleDifference(density, is_count, scale, g.voxel, index, v.z, g.nz, g.nx * g.ny));
 }
 
+// The structure tensor's cell grid over voxel grid g: same origin, cells of
+// `cell` voxels a side, ceil(n / cell) a side (bundleStructureGrid in C++).
+BundleGridBlock bundleStructureCells(BundleGridBlock g, uint cell) {
+  BundleGridBlock c = g;
+  c.voxel = g.voxel * float(cell);
+  c.nx = (g.nx + cell - 1u) / cell;
+  c.ny = (g.ny + cell - 1u) / cell;
+  c.nz = (g.nz + cell - 1u) / cell;
+  return c;
+}
+
+// The largest eigenvalue of symmetric positive semi-definite j, in closed
+// form (the trigonometric solution of the characteristic cubic): exact for
+// a multiple eigenvalue too, where iterative methods converge slowly.
+float bundleLargestEigenvalue(mat3 j) {
+  const float q = (j[0][0] + j[1][1] + j[2][2]) / 3.0;
+  const float off = j[1][0] * j[1][0] + j[2][0] * j[2][0] + j[2][1] * j[2][1];
+  const vec3 d = vec3(j[0][0], j[1][1], j[2][2]) - q;
+  const float p2 = dot(d, d) + 2.0 * off;
+  if (!(p2 > 1e-12 * q * q)) return q;  // a multiple of the identity
+  const float p = sqrt(p2 / 6.0);
+  const float r = clamp(determinant((j - mat3(q)) / p) * 0.5, -1.0, 1.0);
+  return q + 2.0 * p * cos(acos(r) / 3.0);
+}
+
 #endif

@@ -21,8 +21,15 @@
 //             around each sample (glsl/bundling.glsl), so no gradient grid
 //             is kept; the gradient pass writes that grid only for the
 //             tests (GpuBundlerOptions::keep_stages)
+//   structure (structure-aware advection, after the density) per cell of
+//             `cell` voxels a side: the cell's mean density; then per cell
+//             the tensor J = mean of G G^T over the cell and its up to 26
+//             neighbours, G the cell means' central differences (6 floats a
+//             cell: xx xy xz yy yz zz; bundling/bundle_reference.h)
 //   advect    per sample: p += R h (g - d (d . g)) / |g| with g the
-//             trilinear gradient at p, d the fiber's unit direction there
+//             trilinear gradient at p, d the fiber's unit direction there;
+//             structure-aware: g in the numerator becomes M g, M = (J /
+//             lambda1)^power, J trilinear between cell centres
 //   smooth    per sample: p = (1 - phi) p + phi mean(p_j, |j - i| <= k)
 //   relax     per sample: p = o + alpha (p - o), o its unbundled position
 //   map back  per fiber: every original point moves by its sample
@@ -95,6 +102,9 @@ struct BundleSamplePush {
   float radius_across;      // splat: Rb (voxels)
   uint field_is_count;      // advect: 1 when the density is the splat's fixed point (uint)
   float field_scale;        // advect: field_is_count's uint values times this
+  uint64_t structure;       // advect: 6 floats per cell, 0 for the plain advection
+  uint structure_cell;      // advect: voxels a side of a cell (its grid: bundleStructureCells)
+  uint structure_power;     // advect: the filter's power
 };
 
 // Density along one axis and gradient (one invocation per voxel).
@@ -106,15 +116,16 @@ struct BundleGridPush {
   uint src_is_count;  // 1: src holds uint counts
   float radius;       // R in voxels
   float inv_radius2;  // 1 / R^2
-  float src_scale;    // gradient: src_is_count's uint values times this
-  uint pad0;
+  float src_scale;    // gradient, structure mean: src_is_count's uint values times this
+  uint cell;          // structure mean: voxels a side of a cell
 };
 
 #ifdef __cplusplus
 static_assert(sizeof(BundleGridBlock) == 32);
 static_assert(sizeof(BundleFiberPush) == 64);
 static_assert(offsetof(BundleFiberPush, fiber_count) == 48);
-static_assert(sizeof(BundleSamplePush) == 104);
+static_assert(sizeof(BundleSamplePush) == 120);
+static_assert(offsetof(BundleSamplePush, structure) == 104);
 static_assert(offsetof(BundleSamplePush, src) == 32);
 static_assert(offsetof(BundleSamplePush, sample_count) == 72);
 static_assert(sizeof(BundleGridPush) == 72);

@@ -256,4 +256,70 @@ TEST_F(GpuBundling, anisotropicSplatAndIterationMatchTheReference) {
   EXPECT_LT(mean_err, 1e-3 * mean_move + 1e-4);
 }
 
+TEST_F(GpuBundling, structureTensorAndStructureAwareIterationMatchTheReference) {
+  params_.structure_aware = true;
+  params_.structure_scale = 0.6;  // cells of 2 voxels: partial last cells on this grid
+  GpuBundler bundler(context(), GpuBundlerOptions{.keep_stages = true});
+  bundler.load(model_, setup_, params_);
+  const BundleSamples original = toDouble(bundler.originalSamples());
+  bundler.iterate(params_.radius);
+  // The tensor from the GPU's own density, so this checks the tensor alone.
+  const std::vector<float> density = bundler.density();
+  const BundleTensors cpu = structureTensorReference(std::vector<double>(density.begin(), density.end()), setup_.grid,
+                                                     bundleStructureCell(params_));
+  const std::vector<float> gpu = bundler.structure();
+  ASSERT_EQ(gpu.size(), 6 * cpu.size());
+  double scale = 0, worst = 0;
+  for (size_t c = 0; c < cpu.size(); ++c) {
+    const glm::dmat3& j = cpu[c];
+    const double expect[6] = {j[0][0], j[0][1], j[0][2], j[1][1], j[1][2], j[2][2]};
+    for (int k = 0; k < 6; ++k) {
+      scale = std::max(scale, std::abs(expect[k]));
+      worst = std::max(worst, std::abs(expect[k] - double(gpu[6 * c + k])));
+    }
+  }
+  ASSERT_GT(scale, 0);
+  EXPECT_LT(worst, 1e-5 * scale);
+  // The whole iteration, and it is not the plain one.
+  const BundleSamples expect = iterateReference(original, setup_, params_, params_.radius);
+  BundleParams plain = params_;
+  plain.structure_aware = false;
+  const BundleSamples unfiltered = iterateReference(original, setup_, plain, params_.radius);
+  const std::vector<glm::vec4> moved = bundler.samples();
+  double mean_err = 0, mean_move = 0, mean_diff = 0;
+  for (size_t i = 0; i < expect.size(); ++i) {
+    mean_err += glm::length(expect[i] - glm::dvec3(moved[i])) / double(expect.size());
+    mean_move += glm::length(expect[i] - original[i]) / double(expect.size());
+    mean_diff += glm::length(expect[i] - unfiltered[i]) / double(expect.size());
+  }
+  EXPECT_GT(mean_move, 0.1);
+  EXPECT_GT(mean_diff, 0.05 * mean_move);
+  EXPECT_LT(mean_err, 1e-3 * mean_move + 1e-4);
+}
+
+TEST_F(GpuBundling, structureAwareAnisotropicIterationMatchesTheReference) {
+  // The tensor of the splat's fixed-point density.
+  params_.structure_aware = true;
+  params_.mode = BundleMode::Anisotropic;
+  GpuBundler bundler(context());
+  bundler.load(model_, setup_, params_);
+  const BundleSamples original = toDouble(bundler.originalSamples());
+  bundler.iterate(params_.radius);
+  const BundleSamples expect = iterateReference(original, setup_, params_, params_.radius);
+  const std::vector<glm::vec4> moved = bundler.samples();
+  double mean_err = 0, mean_move = 0;
+  for (size_t i = 0; i < expect.size(); ++i) {
+    mean_err += glm::length(expect[i] - glm::dvec3(moved[i])) / double(expect.size());
+    mean_move += glm::length(expect[i] - original[i]) / double(expect.size());
+  }
+  EXPECT_GT(mean_move, 0.1);
+  EXPECT_LT(mean_err, 1e-3 * mean_move + 1e-4);
+}
+
+TEST_F(GpuBundling, structureTensorNeedsTheStructureAwareMode) {
+  GpuBundler bundler(context());
+  bundler.load(model_, setup_, params_);
+  EXPECT_THROW(bundler.structure(), Error);
+}
+
 }  // namespace fibscope

@@ -1,5 +1,7 @@
 #include "bundling/gpu/bundle_passes.h"
 
+#include <algorithm>
+
 #include "gpu/pass_scope.h"
 
 namespace fibscope {
@@ -36,6 +38,8 @@ BundlePipelines createBundlePipelines(const gpu::VulkanContext& context) {
     p.relax = gpu::createComputePipeline(context, "bundle_relax.comp", sample, kGroup);
     p.map_back = gpu::createComputePipeline(context, "bundle_map_back.comp", fiber, kGroup);
     p.splat = gpu::createComputePipeline(context, "bundle_splat.comp", sample, kGroup);
+    p.structure_mean = gpu::createComputePipeline(context, "bundle_structure_mean.comp", grid, kGroup);
+    p.structure = gpu::createComputePipeline(context, "bundle_structure.comp", grid, kGroup);
   } catch (...) {
     destroyBundlePipelines(context, p);
     throw;
@@ -45,7 +49,8 @@ BundlePipelines createBundlePipelines(const gpu::VulkanContext& context) {
 
 void destroyBundlePipelines(const gpu::VulkanContext& context, BundlePipelines& p) {
   for (gpu::ComputePipeline* c :
-       {&p.resample, &p.count, &p.density, &p.gradient, &p.advect, &p.smooth, &p.relax, &p.map_back, &p.splat})
+       {&p.resample, &p.count, &p.density, &p.gradient, &p.advect, &p.smooth, &p.relax, &p.map_back, &p.splat,
+        &p.structure_mean, &p.structure})
     gpu::destroyComputePipeline(context, *c);
 }
 
@@ -85,6 +90,16 @@ void recordBundleDensityAxis(VkCommandBuffer cmd, const gpu::VulkanContext& cont
 void recordBundleGradient(VkCommandBuffer cmd, const gpu::VulkanContext& context, const BundlePipelines& p,
                           const shader::BundleGridPush& push, gpu::GpuTimer* timer) {
   dispatch(cmd, context, p.gradient, push, voxelsOf(push.grid), timer, "bundle gradient");
+}
+void recordBundleStructureMean(VkCommandBuffer cmd, const gpu::VulkanContext& context, const BundlePipelines& p,
+                               const shader::BundleGridPush& push, gpu::GpuTimer* timer) {
+  const uint32_t c = std::max(push.cell, 1u);
+  const uint64_t cells = uint64_t((push.grid.nx + c - 1) / c) * ((push.grid.ny + c - 1) / c) * ((push.grid.nz + c - 1) / c);
+  dispatch(cmd, context, p.structure_mean, push, cells, timer, "bundle structure mean");
+}
+void recordBundleStructure(VkCommandBuffer cmd, const gpu::VulkanContext& context, const BundlePipelines& p,
+                           const shader::BundleGridPush& push, gpu::GpuTimer* timer) {
+  dispatch(cmd, context, p.structure, push, voxelsOf(push.grid), timer, "bundle structure tensor");
 }
 
 }  // namespace fibscope

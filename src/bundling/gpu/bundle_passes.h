@@ -15,7 +15,8 @@
 namespace fibscope {
 
 struct BundlePipelines {
-  gpu::ComputePipeline resample, count, density, gradient, advect, smooth, relax, map_back, splat;
+  gpu::ComputePipeline resample, count, density, gradient, advect, smooth, relax, map_back, splat, structure_mean,
+      structure;
 };
 
 // Throws Error when a pipeline cannot be made (none is left then).
@@ -43,5 +44,11 @@ void recordBundleDensityAxis(VkCommandBuffer cmd, const gpu::VulkanContext& cont
                              const shader::BundleGridPush& push, gpu::GpuTimer* timer);
 void recordBundleGradient(VkCommandBuffer cmd, const gpu::VulkanContext& context, const BundlePipelines& p,
                           const shader::BundleGridPush& push, gpu::GpuTimer* timer);
+// Per cell of the structure tensor: the mean density (push.grid the voxel
+// grid, push.cell its cells), then the tensor (push.grid the cell grid).
+void recordBundleStructureMean(VkCommandBuffer cmd, const gpu::VulkanContext& context, const BundlePipelines& p,
+                               const shader::BundleGridPush& push, gpu::GpuTimer* timer);
+void recordBundleStructure(VkCommandBuffer cmd, const gpu::VulkanContext& context, const BundlePipelines& p,
+                           const shader::BundleGridPush& push, gpu::GpuTimer* timer);
 
 }  // namespace fibscope

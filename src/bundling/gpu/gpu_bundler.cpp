@@ -42,7 +42,7 @@ GpuBundler::~GpuBundler() { release(); }
 
 void GpuBundler::releaseBuffers() {
   for (gpu::Buffer* b : {&points_, &point_offsets_, &sample_offsets_, &sample_fiber_, &original_, &current_, &scratch_,
-                         &counts_, &density_, &density_tmp_, &gradient_})
+                         &counts_, &density_, &density_tmp_, &gradient_, &cell_means_, &structure_})
     gpu::destroyBuffer(context_, *b);
 }
 
@@ -56,7 +56,7 @@ void GpuBundler::release() {
 uint64_t GpuBundler::bytes() const {
   uint64_t total = 0;
   for (const gpu::Buffer* b : {&points_, &point_offsets_, &sample_offsets_, &sample_fiber_, &original_, &current_,
-                               &scratch_, &counts_, &density_, &density_tmp_, &gradient_})
+                               &scratch_, &counts_, &density_, &density_tmp_, &gradient_, &cell_means_, &structure_})
     total += b->size;
   return total;
 }
@@ -120,6 +120,11 @@ void GpuBundler::load(const Tractogram& t, const BundleSetup& setup, const Bundl
   make(scratch_, samples * 16);
   make(counts_, voxels * 4);
   if (isotropic) make(density_, voxels * 4);
+  if (params.structure_aware) {
+    const uint64_t cells = bundleStructureGrid(setup.grid, bundleStructureCell(params)).voxelCount();
+    make(cell_means_, cells * 4);
+    make(structure_, cells * 24);
+  }
   if (options_.keep_stages) {
     make(density_tmp_, voxels * 4);
     make(gradient_, voxels * 16);
@@ -192,6 +197,21 @@ void GpuBundler::iterate(double radius) {
       recordBundleGradient(cmd, context_, pipelines_, g, &timer_);
     }
     shader::BundleSamplePush advect = sample;
+    if (params_.structure_aware) {
+      const uint32_t cell = bundleStructureCell(params_);
+      shader::BundleGridPush mean = g;
+      mean.cell = cell;
+      mean.dst = cell_means_.address;
+      recordBundleStructureMean(cmd, context_, pipelines_, mean, &timer_);
+      shader::BundleGridPush tensor{};
+      tensor.grid = bundleGridBlock(bundleStructureGrid(setup_.grid, cell));
+      tensor.src = cell_means_.address;
+      tensor.dst = structure_.address;
+      recordBundleStructure(cmd, context_, pipelines_, tensor, &timer_);
+      advect.structure = structure_.address;
+      advect.structure_cell = cell;
+      advect.structure_power = params_.structure_power;
+    }
     advect.src = current_.address;
     advect.dst = scratch_.address;
     advect.field = g.src;
@@ -283,6 +303,12 @@ std::vector<float> GpuBundler::density() const {
 std::vector<glm::vec4> GpuBundler::gradient() const {
   if (!options_.keep_stages) throw Error("bundling: gradient() needs GpuBundlerOptions::keep_stages");
   return download<glm::vec4>(context_, gradient_, setup_.grid.voxelCount());
+}
+
+std::vector<float> GpuBundler::structure() const {
+  if (structure_.size == 0) throw Error("bundling: no structure tensor (BundleParams::structure_aware is off)");
+  return download<float>(context_, structure_,
+                         6 * bundleStructureGrid(setup_.grid, bundleStructureCell(params_)).voxelCount());
 }
 
 std::vector<float> bundleOnGpu(const gpu::VulkanContext& context, const Tractogram& tractogram,

@@ -9,7 +9,8 @@
 // Device memory: 8 B per fiber; 52 B per sample (three vec4 copies, its
 // fiber); 8 B per voxel isotropic (counts, density; the separable density's
 // middle pass writes into the counts), 4 B anisotropic (the splat's
-// density); one chunk of points (GpuBundlerOptions::chunk_bytes, or the
+// density); structure-aware, 28 B a cell of the structure tensor (its
+// mean density, its 6 floats: under 3.5 B a voxel); one chunk of points (GpuBundlerOptions::chunk_bytes, or the
 // longest fiber). No gradient grid: the advection takes the gradient from
 // the density at the voxels around each sample. bytes() says what one load
 // holds (the staging copies of the chunks are host memory).
@@ -55,7 +56,7 @@ class GpuBundler {
   // resamples it. Throws Error when memory runs out.
   void load(const Tractogram& tractogram, const BundleSetup& setup, const BundleParams& params);
   // One iteration at kernel radius `radius` (voxels): count, density x y z,
-  // gradient, advection, smoothing. Submits and waits.
+  // gradient, (structure tensor,) advection, smoothing. Submits and waits.
   void iterate(double radius);
   // Relaxation (alpha = params.relaxation) and mapping back: the bundled
   // points, x y z per point of `tractogram` (the one given to load). Submits
@@ -71,6 +72,9 @@ class GpuBundler {
   std::vector<uint32_t> counts() const;
   std::vector<float> density() const;  // after the z pass (isotropic)
   std::vector<glm::vec4> gradient() const;
+  // structure_aware only: the structure tensor of the last iteration, 6
+  // floats a cell (xx xy xz yy yz zz; bundleStructureGrid's order).
+  std::vector<float> structure() const;
 
   uint64_t bytes() const;  // device memory of the loaded model
   // GPU milliseconds of each pass name, summed since load().
@@ -95,6 +99,7 @@ class GpuBundler {
   gpu::GpuTimer timer_;
   gpu::Buffer points_, point_offsets_, sample_offsets_, sample_fiber_, original_, current_, scratch_;
   gpu::Buffer counts_, density_, density_tmp_, gradient_;  // the last two: keep_stages
+  gpu::Buffer cell_means_, structure_;                      // structure_aware
   BundleSetup setup_;
   BundleParams params_;
   uint32_t fibers_ = 0;
