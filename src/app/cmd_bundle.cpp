@@ -51,6 +51,12 @@ void addBundleCommand(CLI::App& app) {
   cmd->add_flag("--anchor-ends", p.anchor_ends, "Keep the fibers' end points where they are");
   cmd->add_option("--anisotropy", p.anisotropy, "Anisotropic mode: kernel radius across the fiber / along it")
       ->capture_default_str();
+  cmd->add_flag("--structure-aware", p.structure_aware,
+                "Filter the advection by the density's structure tensor, so sheets contract across, not into strands");
+  cmd->add_option("--structure-power", p.structure_power, "Structure-aware: the filter's power (1-8)")
+      ->capture_default_str();
+  cmd->add_option("--structure-scale", p.structure_scale, "Structure-aware: the tensor's cells, multiples of R")
+      ->capture_default_str();
   cmd->add_option("--mode", opt->mode, "isotropic (the paper's) or anisotropic (a kernel elongated along each fiber)")
       ->check(CLI::IsMember({"isotropic", "anisotropic"}))
       ->capture_default_str();
@@ -112,6 +118,9 @@ void addBundleCommand(CLI::App& app) {
         params.advection, params.anchor_ends ? ", ends anchored" : "");
     if (params.mode == BundleMode::Anisotropic)
       std::printf("  anisotropy  %.3g (kernel radius across / along)\n", params.anisotropy);
+    if (params.structure_aware)
+      std::printf("  structure   aware: power %u, cells of %u voxels\n", params.structure_power,
+                  bundleStructureCell(params));
     std::printf("  ink         %llu -> %llu px (%.1f%%) in a %u x %u coronal view\n",
                 static_cast<unsigned long long>(ink_before), static_cast<unsigned long long>(ink_after),
                 ink_before ? 100.0 * double(ink_after) / double(ink_before) : 0.0, camera.width, camera.height);

@@ -75,6 +75,12 @@ TEST(Bundling, invalidParamsNameTheParameter) {
   p = {};
   p.radius_decay = 1.2;
   EXPECT_NE(bundleParamsProblem(p).find("radius decay"), std::string::npos);
+  p = {};
+  p.structure_power = 9;
+  EXPECT_NE(bundleParamsProblem(p).find("structure power is 9"), std::string::npos) << bundleParamsProblem(p);
+  p = {};
+  p.structure_scale = 0.05;
+  EXPECT_NE(bundleParamsProblem(p).find("structure scale"), std::string::npos);
   EXPECT_NE(test::errorOf([] { parseBundleMode("radial"); }).find("radial"), std::string::npos);
 }
 

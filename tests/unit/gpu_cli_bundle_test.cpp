@@ -67,6 +67,22 @@ TEST(GpuCliBundle, bundledPhantomKeepsItsFibersAndMovesItsPoints) {
   r = test::runFibscope("info " + dir.file("out.fbl"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("streamlines           200"), std::string::npos) << r.output;
+
+  // Structure-aware advection: said in the report, and it moves the points
+  // otherwise than the plain run with the same parameters.
+  r = test::runFibscope("bundle " + dir.file("in.tck") + " " + dir.file("aware.trk") + kSmall +
+                        " --iterations 3 --structure-aware --structure-power 3 --report");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("structure   aware: power 3"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("bundle structure tensor"), std::string::npos) << r.output;
+  const Tractogram aware = readTractogram(dir.file("aware.trk"));
+  ASSERT_EQ(aware.offsets, in.offsets);
+  double differ = 0;
+  for (size_t i = 0; i < in.pointCount(); ++i)
+    differ += std::hypot(aware.point(i)[0] - out.point(i)[0], aware.point(i)[1] - out.point(i)[1],
+                         aware.point(i)[2] - out.point(i)[2]) /
+              double(in.pointCount());
+  EXPECT_GT(differ, 0.05 * mean);
 }
 
 TEST(CliBundle, malformedOptionsExitWith2BeforeWritingAnything) {
@@ -81,6 +97,11 @@ TEST(CliBundle, malformedOptionsExitWith2BeforeWritingAnything) {
   EXPECT_NE(r.output.find("smoothing is 1.5"), std::string::npos) << r.output;
   r = test::runFibscope("bundle " + dir.file("in.tck") + " " + dir.file("out.tck") + " --mode radial");
   EXPECT_EQ(r.exit_code, 2) << r.output;
+  r = test::runFibscope("bundle " + dir.file("in.tck") + " " + dir.file("out.tck") +
+                        " --structure-aware --structure-power 0");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_EQ(lineCount(r.output), 1) << r.output;
+  EXPECT_NE(r.output.find("structure power is 0"), std::string::npos) << r.output;
   r = test::runFibscope("bundle " + dir.file("in.tck") + " " + dir.file("out.xyz"));
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("out.xyz"), std::string::npos) << r.output;

@@ -47,6 +47,15 @@ TEST(ViewerBundlingScript, parsesBundleWaitShowAndSave) {
   // The defaults are the paper's.
   const auto plain = parseScript("bundle\n", "s.txt");
   EXPECT_EQ(std::get<BundleAction>(std::get<ViewerAction>(plain[0].command)).params.iterations, 15u);
+  EXPECT_FALSE(std::get<BundleAction>(std::get<ViewerAction>(plain[0].command)).params.structure_aware);
+  const auto aware = parseScript("bundle structure=1 structure-power=3 structure-scale=1.5\n", "s.txt");
+  const BundleParams& a = std::get<BundleAction>(std::get<ViewerAction>(aware[0].command)).params;
+  EXPECT_TRUE(a.structure_aware);
+  EXPECT_EQ(a.structure_power, 3u);
+  EXPECT_EQ(a.structure_scale, 1.5);
+  for (const char* bad : {"bundle structure=2\n", "bundle structure-power=0\n", "bundle structure-power=2.5\n",
+                          "bundle structure-scale=9\n"})
+    EXPECT_THROW(parseScript(bad, "s.txt"), Error) << bad;
 }
 
 TEST(ViewerBundlingScript, parsesSplitViewOnAndOff) {

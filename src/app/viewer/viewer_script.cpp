@@ -356,10 +356,18 @@ std::variant<ViewerAction, WaitFrames, WaitLoaded, WaitExported, WaitBundled> pa
       else if (key == "decay") p.radius_decay = v;
       else if (key == "advection") p.advection = v;
       else if (key == "anisotropy") p.anisotropy = v;
+      else if (key == "structure") {
+        if (v != 0 && v != 1) throw Error("bundle: structure: expected 0 or 1, got " + std::string(value));
+        p.structure_aware = v == 1;
+      } else if (key == "structure-power") {
+        if (!(v >= 1 && v <= 8) || v != std::floor(v))
+          throw Error("bundle: structure-power: expected 1 to 8, got " + std::string(value));
+        p.structure_power = uint32_t(v);
+      } else if (key == "structure-scale") p.structure_scale = v;
       else
         throw Error("bundle: unknown key '" + std::string(key) +
                     "' (expected radius, iterations, voxel, step, smoothing, relaxation, decay, advection, "
-                    "anisotropy or mode)");
+                    "anisotropy, structure, structure-power, structure-scale or mode)");
     }
     try {
       validateBundleParams(p);

@@ -43,7 +43,8 @@
 //   expect-kept N              (the run fails naming the line unless the filter keeps N fibers)
 // bundling (viewer_bundling.h):
 //   bundle [KEY=VALUE ...]     (the active model on a worker; KEY: radius iterations voxel step smoothing
-//                              relaxation decay advection anisotropy mode=isotropic|anisotropic, as
+//                              relaxation decay advection anisotropy mode=isotropic|anisotropic
+//                              structure=0|1 structure-power structure-scale, as
 //                              `fibscope bundle`'s options; 0 for voxel or step: the default fraction)
 //   wait-bundle                (holds until the bundled copy is a model: shown and active, the source hidden)
 //   show-model N               (model N shown and active, the others hidden: original / bundled)

@@ -64,6 +64,15 @@ void drawBundlingPanel(ViewerState& state, std::vector<ViewerAction>& actions) {
   ImGui::SetNextItemWidth(120);
   if (ImGui::Combo("mode", &mode, "isotropic\0anisotropic\0")) p.mode = mode ? BundleMode::Anisotropic : BundleMode::Isotropic;
   if (p.mode == BundleMode::Anisotropic) ImGui::InputDouble("anisotropy", &p.anisotropy, 0.05, 0.1, "%.3g");
+  // Structure-aware advection (docs/BUNDLING.md): sheets stay sheets.
+  ImGui::Checkbox("structure-aware", &p.structure_aware);
+  if (p.structure_aware) {
+    int power = int(p.structure_power);
+    ImGui::SetNextItemWidth(120);
+    if (ImGui::InputInt("structure power", &power)) p.structure_power = uint32_t(std::clamp(power, 1, 8));
+    ImGui::SetNextItemWidth(120);
+    ImGui::InputDouble("structure scale (R)", &p.structure_scale, 0.1, 0.5, "%.3g");
+  }
   const bool has_model = state.active_model >= 0 && state.active_model < int(state.models.size());
   ImGui::BeginDisabled(!has_model);
   const std::string label =
