@@ -10,7 +10,7 @@
 // fiber); 8 B per voxel isotropic (counts, density; the separable density's
 // middle pass writes into the counts), 4 B anisotropic (the splat's
 // density); structure-aware, 28 B a cell of the structure tensor (its
-// mean density, its 6 floats: under 3.5 B a voxel); one chunk of points (GpuBundlerOptions::chunk_bytes, or the
+// mean density, its 6 floats: at most 3.5 B a voxel); one chunk of points (GpuBundlerOptions::chunk_bytes, or the
 // longest fiber). No gradient grid: the advection takes the gradient from
 // the density at the voxels around each sample. bytes() says what one load
 // holds (the staging copies of the chunks are host memory).
