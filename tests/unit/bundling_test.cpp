@@ -16,6 +16,18 @@
 namespace fibscope {
 namespace {
 
+// Half-millimetre voxels, 1 mm samples and quarter steps: the two-fiber
+// and sheet models' runs, where a whole step would jump their gaps.
+BundleParams fineParams(double radius, uint32_t iterations) {
+  BundleParams p;
+  p.voxel_mm = 0.5;
+  p.step_mm = 1;
+  p.radius = radius;
+  p.iterations = iterations;
+  p.advection = 0.25;
+  return p;
+}
+
 BundleGrid smallGrid(glm::uvec3 size, double voxel = 2.0) {
   BundleGrid g;
   g.origin = glm::dvec3(-10.0, -7.0, -5.0);
@@ -341,12 +353,7 @@ TEST(Bundling, anisotropicModeKeepsFibersFartherApartThanTheIsotropic) {
   }
   t.addStreamline(a.data(), 21);
   t.addStreamline(b.data(), 21);
-  BundleParams p;
-  p.voxel_mm = 0.5;
-  p.step_mm = 1;
-  p.radius = 8;
-  p.iterations = 2;
-  p.advection = 0.25;
+  BundleParams p = fineParams(8, 2);
   const std::vector<float> iso = bundleReference(t, p);
   p.mode = BundleMode::Anisotropic;
   const std::vector<float> aniso = bundleReference(t, p);
@@ -487,12 +494,7 @@ TEST(Bundling, structureAwareAdvectionStepsAcrossASheetOnly) {
 
 TEST(Bundling, structureAwareModeKeepsASheetFromBreakingIntoStrands) {
   const Tractogram t = sheetModel(24, 7);
-  BundleParams p;
-  p.voxel_mm = 0.5;
-  p.step_mm = 1;
-  p.radius = 4;
-  p.iterations = 8;
-  p.advection = 0.25;
+  BundleParams p = fineParams(4, 8);
   const std::vector<float> iso = bundleReference(t, p);
   p.structure_aware = true;
   const std::vector<float> aware = bundleReference(t, p);
