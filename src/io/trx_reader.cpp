@@ -137,6 +137,10 @@ void TrxReader::parseHeader() {
     header = nlohmann::json::parse(text);
   } catch (const nlohmann::json::parse_error& e) {
     failMember("header.json", "byte " + std::to_string(e.byte) + ": invalid JSON (" + oneLine(e.what()) + ")");
+  } catch (const nlohmann::json::exception& e) {
+    // Not only syntax: a number beyond double's range (1e999) is
+    // out_of_range.406, which escaped as a crash before.
+    failMember("header.json", "invalid JSON (" + oneLine(e.what()) + ")");
   }
   if (!header.is_object()) failMember("header.json", std::string("expected a JSON object, found ") + header.type_name());
 

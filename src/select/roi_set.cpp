@@ -208,7 +208,9 @@ json parseStrict(const std::string& text, const std::string& path) {
   };
   try {
     return json::parse(text, check);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {
+    // parse_error, and out_of_range.406 for a number beyond double's range
+    // (1e999), which escaped as a crash before.
     std::string what = e.what();
     if (const size_t bracket = what.find("] "); what.starts_with("[json.exception") && bracket != std::string::npos)
       what = what.substr(bracket + 2);

@@ -184,6 +184,7 @@ TEST(RoiSet, malformedFilesAreOneLineErrorsNamingFileAndPlace) {
       {"{" + v + R"(, "ends_only": true, "ends_only": false})", "repeated key \"ends_only\""},
       {"{" + v + ", ", "invalid JSON: "},
       {"", "invalid JSON: "},
+      {"{" + v + R"(, "min_length_mm": 1e999})", "invalid JSON: number overflow"},  // escaped as a crash once
       {"[1]", "expected a JSON object, found an array"},
       {deep, "JSON nests deeper than 8 levels"},
   };

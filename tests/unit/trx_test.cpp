@@ -710,6 +710,10 @@ TEST(TrxMalformed, headerProblemsAreReported) {
   expectOneLineError(readError(trx), trx, "invalid JSON");
   test::writeBytes(trx + "/header.json", "");
   expectOneLineError(readError(trx), trx, "invalid JSON");
+  // A number beyond double's range is nlohmann's out_of_range, not a
+  // parse_error: it escaped the reader as a crash once.
+  test::writeBytes(trx + "/header.json", "{\"NB_STREAMLINES\": 1e999}");
+  expectOneLineError(readError(trx), trx, "invalid JSON");
   test::writeBytes(trx + "/header.json", "{\"a\": " + std::string(100000, '[') + std::string(100000, ']') + "}");
   expectOneLineError(readError(trx), trx, "nests deeper");
 }
