@@ -1,5 +1,6 @@
 #include "select/region.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -54,14 +55,22 @@ Region parseRegion(std::string_view spec) {
   const std::string_view values = colon == std::string_view::npos ? spec : spec.substr(colon + 1);
   std::vector<double> v;
   const bool numbers = parseNumberList(values, v);
+  // Coordinates and sizes (the first 6; an oriented box's angles are free).
+  const auto checkRange = [&](size_t n) {
+    for (size_t i = 0; i < std::min(n, v.size()); ++i)
+      if (!(std::fabs(v[i]) <= kMaxRegionMm))
+        fail(text, "a coordinate or size beyond " + number(kMaxRegionMm) + " mm (" + number(v[i]) + ")");
+  };
   if (kind == "sphere") {
     if (!numbers || v.size() != 4)
       fail(text, "expected a sphere as sphere:X,Y,Z,R (mm; or X,Y,Z,R)");
-    if (!(v[3] > 0)) fail(text, "a sphere's radius must be > 0 mm");
+    checkRange(4);
+    if (!(float(v[3]) > 0)) fail(text, "a sphere's radius must be > 0 mm");
     return SphereRegion{{float(v[0]), float(v[1]), float(v[2])}, float(v[3])};
   }
   if (kind == "box") {
     if (!numbers || v.size() != 6) fail(text, "expected a box as box:X0,Y0,Z0,X1,Y1,Z1 (two opposite corners, mm)");
+    checkRange(6);
     BoxRegion b;
     for (int k = 0; k < 3; ++k) {
       b.min[k] = std::min(v[k], v[k + 3]);
@@ -73,7 +82,8 @@ Region parseRegion(std::string_view spec) {
     if (!numbers || v.size() != 9)
       fail(text, "expected an oriented box as obox:CX,CY,CZ,SX,SY,SZ,AX,AY,AZ (centre and sizes in mm, rotation "
                  "about x, y, z in degrees)");
-    if (!(v[3] > 0 && v[4] > 0 && v[5] > 0)) fail(text, "an oriented box's sizes must be > 0 mm");
+    checkRange(6);
+    if (!(float(v[3]) > 0 && float(v[4]) > 0 && float(v[5]) > 0)) fail(text, "an oriented box's sizes must be > 0 mm");
     // R = Rz Ry Rx: the box's axes are R's columns.
     glm::dmat4 r(1.0);
     r = glm::rotate(r, glm::radians(v[8]), glm::dvec3(0, 0, 1));

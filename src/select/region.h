@@ -26,6 +26,12 @@
 
 namespace fibscope {
 
+// The largest coordinate, radius or size a region's spec may give (mm): 1 km
+// from the origin, as an OBJ mesh's (io/obj_mesh.h). The tests run in float
+// and cut meshes are built from regions: beyond it corners and squared
+// distances overflow to infinity.
+inline constexpr double kMaxRegionMm = 1e6;
+
 // Inside when the squared distance to the centre is <= radius^2, computed
 // in float as MRtrix3 does (so a vertex on the boundary is decided the same).
 struct SphereRegion {
@@ -57,7 +63,8 @@ bool regionContains(const Region& region, const float* p);
 
 // The region a spec names. Throws Error "SPEC: ..." (one line: what was
 // expected) for anything else: an unknown kind, a wrong number of values,
-// non-finite values, a radius or size <= 0; for a mask whose image cannot be
+// non-finite values, a coordinate, radius or size beyond kMaxRegionMm, a
+// radius or size <= 0 (in float); for a mask whose image cannot be
 // used, loadVoxelMask's Error "PATH: ...". Safe on untrusted text and files.
 Region parseRegion(std::string_view spec);
 // The spec of a region: parseRegion(regionSpec(r)) gives r again (to the

@@ -51,12 +51,19 @@ TEST(Region, spheresBoxesAndOrientedBoxesContainTheirPoints) {
 
 TEST(Region, malformedSpecsAreOneLineErrorsNamingTheSpec) {
   for (const std::string spec : {"sphere:1,2,3", "sphere:1,2,3,0", "sphere:1,2,3,-1", "sphere:a,b,c,d", "box:1,2,3",
-                                 "obox:0,0,0,1,1,0,0,0,0", "cube:1,2,3,4", "", "1,2,3,nan", "1,2,3,4,"}) {
+                                 "obox:0,0,0,1,1,0,0,0,0", "cube:1,2,3,4", "", "1,2,3,nan", "1,2,3,4,",
+                                 // beyond kMaxRegionMm, or a size float rounds to 0: corners and squared
+                                 // distances would be infinite in float (found by fuzz_specs)
+                                 "box:-4e125,-5,5,5,5,5", "sphere:0,0,0,1e-50", "sphere:2e6,0,0,1",
+                                 "obox:0,0,0,1,1,3e38,0,0,0", "obox:0,0,0,1,1,1e-46,0,0,0"}) {
     SCOPED_TRACE(spec);
     const std::string message = test::errorOf([&] { parseRegion(spec); });
     EXPECT_EQ(message.rfind(spec + ": ", 0), 0u) << message;
     EXPECT_EQ(message.find('\n'), std::string::npos) << message;
   }
+  // The largest accepted: 1 km from the origin.
+  EXPECT_NO_THROW(parseRegion("box:-1e6,-1e6,-1e6,1e6,1e6,1e6"));
+  EXPECT_NO_THROW(parseRegion("obox:1e6,0,0,1e6,1,1,1e9,0,0"));  // any angle
 }
 
 // A streamline along x from x0 to x1 at y, z, 1 mm steps.
