@@ -62,7 +62,9 @@ void checkScalarRange(const ScalarRange& r, const std::string& what) {
 }
 
 std::string scalarRangeArray(const ScalarRange& r) {
-  return r.component == 0 ? r.name : r.name + "[" + std::to_string(r.component) + "]";
+  // A name that ends in "]" itself keeps its "[0]": "a[2]" alone would read
+  // back as component 2 of "a" (found by fuzz_specs).
+  return r.component == 0 && !r.name.ends_with(']') ? r.name : r.name + "[" + std::to_string(r.component) + "]";
 }
 
 std::string scalarRangeSpec(const ScalarRange& r) {

@@ -35,7 +35,7 @@ struct ScalarRange {
 ScalarRange parseScalarRange(std::string_view spec);
 // The spec again (parseScalarRange(scalarRangeSpec(r)) == r to the double).
 std::string scalarRangeSpec(const ScalarRange& range);
-// "NAME" for component 0, else "NAME[K]".
+// "NAME" for component 0, else "NAME[K]"; "NAME[0]" where NAME ends in "]".
 std::string scalarRangeArray(const ScalarRange& range);
 // For reports: "fa_mean outside [0.3, inf]" (open ends as -inf / inf).
 std::string scalarRangeOutside(const ScalarRange& range);

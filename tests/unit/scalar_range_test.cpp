@@ -38,8 +38,16 @@ TEST(ScalarRange, specsParseWithOpenEndsAndComponents) {
   EXPECT_EQ(c.name, "a:b");
   EXPECT_EQ(c.min, -1);
   EXPECT_EQ(c.max, 2000);
-  for (const ScalarRange& r : {a, b, c}) {
+  // A name ending in "[K]" itself (an array named "t[2]"): its component 0
+  // is written out, or the spec would read back as component 2 of "t".
+  const ScalarRange d = parseScalarRange("t[2][0]:0:1");
+  EXPECT_EQ(d.name, "t[2]");
+  EXPECT_EQ(d.component, 0u);
+  EXPECT_EQ(scalarRangeSpec(d), "t[2][0]:0:1");
+  for (const ScalarRange& r : {a, b, c, d}) {
     const ScalarRange again = parseScalarRange(scalarRangeSpec(r));
+    EXPECT_EQ(again.name, r.name);  // (open ends are NaN: no operator== on the whole)
+    EXPECT_EQ(again.component, r.component);
     EXPECT_EQ(scalarRangeSpec(again), scalarRangeSpec(r));
   }
   EXPECT_EQ(scalarRangeOutside(a), "fa_mean outside [0.3, inf]");
