@@ -274,6 +274,65 @@ TEST(OrbitController, resetAnimatesBackToTheFramedView) {
   expectNear(end.target, start.target, 1e-9);
 }
 
+// A model added within the scene (a bundled or filtered copy) or one closed
+// leaves the user's rotated, panned and zoomed view exactly as it was.
+TEST(OrbitController, refitWithinTheSceneKeepsTheView) {
+  OrbitController controller = framedController();
+  controller.rotate(300, 100);
+  controller.pan(20, -10);
+  controller.dolly(3);
+  controller.update(2.0);
+  const Camera before = controller.camera(320, 240);
+  const Bounds inner = {{-40, -60, -20}, {72, 80, 50}};  // within kBox grown by 10 % of its diagonal
+  controller.refit(inner, boxSample(inner, 300));
+  EXPECT_FALSE(controller.animating());
+  const Camera after = controller.camera(320, 240);
+  expectNear(after.eye, before.eye, 1e-9);
+  expectNear(after.target, before.target, 1e-9);
+  expectNear(trueUp(after), trueUp(before), 1e-12);
+  expectEnclosesBounds(after, inner);
+  // reset() now frames the new box: the default view of it.
+  controller.reset();
+  controller.update(2.0);
+  OrbitController fresh;
+  fresh.setViewport(320, 240);
+  fresh.frame(inner, boxSample(inner, 300));
+  expectNear(controller.camera(320, 240).eye, fresh.camera(320, 240).eye, 1e-6);
+}
+
+// A model elsewhere: the orientation stays, target and distance frame the
+// new scene snugly along it (every sample point within the image).
+TEST(OrbitController, refitBeyondTheSceneKeepsTheOrientationAndFramesTheNewBox) {
+  OrbitController controller = framedController();
+  controller.rotate(-200, 150);
+  controller.update(2.0);
+  const Camera before = controller.camera(320, 240);
+  const Bounds far_box = {{200, -80, -40}, {420, 90, 160}};
+  Bounds both = kBox;
+  for (int k = 0; k < 3; ++k) both.min[k] = std::min(kBox.min[k], far_box.min[k]), both.max[k] = std::max(kBox.max[k], far_box.max[k]);
+  std::vector<Vec3d> sample = boxSample(kBox, 300), far_sample = boxSample(far_box, 300);
+  sample.insert(sample.end(), far_sample.begin(), far_sample.end());
+  controller.refit(both, sample);
+  EXPECT_TRUE(controller.animating());
+  controller.update(2.0);
+  const Camera after = controller.camera(320, 240);
+  expectNear(viewDirection(after), viewDirection(before), 1e-9);
+  expectNear(trueUp(after), trueUp(before), 1e-9);
+  expectEnclosesBounds(after, both);
+  double extent = 0;
+  for (const Vec3d& p : sample) {
+    const auto w = project(after, p);
+    EXPECT_GE(w[0], 0.0);
+    EXPECT_LE(w[0], 320.0);
+    EXPECT_GE(w[1], 0.0);
+    EXPECT_LE(w[1], 240.0);
+    extent = std::max({extent, std::fabs(w[0] - 160) / 160, std::fabs(w[1] - 120) / 120});
+  }
+  EXPECT_GT(extent, 0.8) << "snug, not merely inside";
+  // The dolly limits follow the new scene.
+  EXPECT_GT(controller.fittedDistance(), framedController().fittedDistance());
+}
+
 TEST(OrbitController, emptyOrDegenerateBoundsStillGiveAValidCamera) {
   OrbitController controller;
   controller.frame(Bounds{}, {});

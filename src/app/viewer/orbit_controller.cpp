@@ -51,30 +51,65 @@ OrbitController::State OrbitController::defaultState() const {
   auto make = [&](double factor) {
     return orbitCamera(bounds_, kDefaultAzimuthDeg, kDefaultElevationDeg, w, h, factor, fov_y_deg_);
   };
-  Camera fitted;
-  if (sample_.empty()) {
-    const std::array<Vec3d, 8> corners = boundsCorners(bounds_);
-    fitted = snugCamera(corners, make);
-  } else {
-    fitted = snugCamera(sample_, make);
-  }
-  State state;
-  state.target = fitted.target;
-  const Vec3d back = array(vec(fitted.eye) - vec(fitted.target));
-  state.distance = glm::length(vec(back));
-  state.orientation = orientationOf(back, fitted.up);
+  const std::array<Vec3d, 8> corners = boundsCorners(bounds_);
+  return stateOf(sample_.empty() ? snugCamera(corners, make) : snugCamera(sample_, make));
+}
+
+OrbitController::State OrbitController::fittedState(const Quat& orientation) const {
+  const uint32_t w = std::max<uint32_t>(viewport_width_, 1), h = std::max<uint32_t>(viewport_height_, 1);
+  const Vec3d back = axis(orientation, {0, 0, 1}), up = axis(orientation, {0, 1, 0});
+  auto make = [&](double factor) { return fitCamera(bounds_, back, up, w, h, factor, fov_y_deg_); };
+  const std::array<Vec3d, 8> corners = boundsCorners(bounds_);
+  State state = stateOf(sample_.empty() ? snugCamera(corners, make) : snugCamera(sample_, make));
+  state.orientation = orientation;  // exactly, not re-derived through the eye
   return state;
 }
 
-void OrbitController::frame(const Bounds& bounds, std::span<const Vec3d> sample) {
-  Bounds b = bounds;
+OrbitController::State OrbitController::stateOf(const Camera& camera) {
+  State state;
+  state.target = camera.target;
+  const Vec3d back = array(vec(camera.eye) - vec(camera.target));
+  state.distance = glm::length(vec(back));
+  state.orientation = orientationOf(back, camera.up);
+  return state;
+}
+
+namespace {
+
+// An empty or broken box: a point at the origin (fitCamera gives it 1 mm).
+Bounds usable(Bounds b) {
   for (int k = 0; k < 3; ++k)
-    if (!(b.min[k] <= b.max[k]) || !std::isfinite(b.min[k]) || !std::isfinite(b.max[k]))
-      b = Bounds{};  // an empty or broken box: a point at the origin (fitCamera gives it 1 mm)
-  bounds_ = b;
+    if (!(b.min[k] <= b.max[k]) || !std::isfinite(b.min[k]) || !std::isfinite(b.max[k])) return Bounds{};
+  return b;
+}
+
+// Whether `inner` lies within `outer` grown by `slack` of its diagonal.
+bool within(const Bounds& inner, const Bounds& outer, double slack) {
+  const double grow = slack * glm::length(vec(outer.max) - vec(outer.min));
+  for (int k = 0; k < 3; ++k)
+    if (inner.min[k] < outer.min[k] - grow || inner.max[k] > outer.max[k] + grow) return false;
+  return true;
+}
+
+}  // namespace
+
+void OrbitController::frame(const Bounds& bounds, std::span<const Vec3d> sample) {
+  bounds_ = usable(bounds);
   sample_.assign(sample.begin(), sample.end());
   goal_ = shown_ = defaultState();
   fitted_distance_ = goal_.distance;
+}
+
+void OrbitController::refit(const Bounds& bounds, std::span<const Vec3d> sample) {
+  const Bounds old = bounds_;
+  bounds_ = usable(bounds);
+  sample_.assign(sample.begin(), sample.end());
+  fitted_distance_ = defaultState().distance;  // the dolly limits follow the new box
+  if (!within(bounds_, old, kRefitSlack)) {
+    const Quat kept = goal_.orientation;
+    goal_ = fittedState(kept);
+  }
+  goal_.distance = clampDistance(goal_.distance);
 }
 
 void OrbitController::reset() {

@@ -57,9 +57,18 @@ class OrbitController {
   // orbitCamera's conventions) looking at the box centre, at the distance
   // that frames `sample` snugly (snugCamera; the box's corners when the
   // sample is empty) for the last viewport size and field of view. The
-  // displayed camera jumps there (a new model); remembers bounds and sample
+  // displayed camera jumps there (the first model); remembers bounds and sample
   // for reset() and for the near/far planes.
   void frame(const Bounds& bounds, std::span<const Vec3d> sample);
+  // A model added or closed while others are shown: remembers the new
+  // bounds and sample as frame() does (reset() and the near/far planes use
+  // them) without taking the user's view away, as mrview keeps it when a
+  // tractogram is added. Where the new box lies within the old one grown by
+  // kRefitSlack of its diagonal (a bundled or filtered copy, a model
+  // closed) the view stays as it is; otherwise the orientation stays and
+  // the target and distance frame the new box snugly along it. Animated.
+  void refit(const Bounds& bounds, std::span<const Vec3d> sample);
+  static constexpr double kRefitSlack = 0.10;
   // The reset key: animates back to the view frame() chose (re-fitted for the
   // current viewport and field of view).
   void reset();
@@ -117,6 +126,10 @@ class OrbitController {
   };
   Camera makeCamera(const State& state, uint32_t width, uint32_t height) const;
   State defaultState() const;
+  // The snug fit of bounds_ / sample_ seen along `orientation`.
+  State fittedState(const Quat& orientation) const;
+  // The state of a camera (its eye, target and up).
+  static State stateOf(const Camera& camera);
   double clampDistance(double distance) const;
 
   Bounds bounds_;

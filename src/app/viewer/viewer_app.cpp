@@ -161,7 +161,8 @@ class ViewerApp {
   void addModel(LoadEvent& event);
   void closeModel(int model);
   // The camera on the union of the visible models (every model when none
-  // is visible), and the scalar range on their fiber lengths.
+  // is visible): framed for the first, refitted after; and the scalar range
+  // on their fiber lengths.
   void frameVisibleModels();
   // frameVisibleModels when a model was added or closed since the last.
   void frameIfModelsChanged();
@@ -629,6 +630,9 @@ void ViewerApp::frameIfModelsChanged() {
 }
 
 void ViewerApp::frameVisibleModels() {
+  // The first model frames the default view; later additions and closes
+  // keep the user's (OrbitController::refit).
+  const bool keep_view = !framed_ids_.empty();
   framed_ids_.clear();
   for (const auto& m : scenes_) framed_ids_.push_back(m->id);
   bool any_visible = false;
@@ -644,7 +648,8 @@ void ViewerApp::frameVisibleModels() {
     sample.insert(sample.end(), data.sample.begin(), data.sample.end());
   }
   if (!first) {
-    controller_.frame(bounds, sample);
+    if (keep_view) controller_.refit(bounds, sample);
+    else controller_.frame(bounds, sample);
     state_.scene_bounds = bounds;
   }
 }
@@ -1601,7 +1606,8 @@ bool ViewerApp::drawFrame(uint32_t width, uint32_t height, double dt) {
     dissection_opened_ = true;
   }
   for (const ViewerAction& action : drawViewerUi(state_)) apply(action);
-  // A model added or closed: the camera frames every visible model. Show,
+  // A model added or closed: the camera's box takes in every visible model
+  // (the first framed, later ones keeping the user's view: refit). Show,
   // hide and switching the active model keep the view (the user may hide a
   // model to look inside another).
   frameIfModelsChanged();
