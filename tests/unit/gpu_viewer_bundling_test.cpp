@@ -263,6 +263,31 @@ TEST_F(GpuViewerBundling, splitViewShowsTheOriginalLeftAndTheBundledCopyRightFro
 // full-width reference is the single view with the original shown again:
 // its near and far enclose every visible model, not only the framed copy
 // (before, they cut the original's front and back: 77 % agreement).
+// A model added within the scene (here a shrunken copy, as a bundled copy
+// is) keeps the view the user had turned and zoomed to: with the copy
+// hidden again the picture is the one before it was opened.
+TEST_F(GpuViewerBundling, addingAModelKeepsTheUsersView) {
+  const Tractogram big = test::smallTractogram(60, 3);
+  Tractogram small = big;
+  for (float& v : small.positions) v *= 0.8f;  // about the origin, inside the original's box
+  const std::string big_tck = dir_.file("big.tck"), small_tck = dir_.file("small.tck");
+  writeTractogram(big_tck, big, TractogramHeader{});
+  writeTractogram(small_tck, small, TractogramHeader{});
+  const std::string before = dir_.file("before.png"), after = dir_.file("after.png"),
+                    reset = dir_.file("reset.png"), script = dir_.file("s.txt");
+  test::writeBytes(script, "wait-loaded\nset ssao off\nset fxaa off\nset orientation-labels off\n"
+                           "set background 0,0,0\norbit 240 90\ndolly 2\nwait 1\nscreenshot " + before +
+                           " 128x72\nopen " + small_tck + "\nwait-loaded\nmodel 1 hide\nwait 1\nscreenshot " +
+                           after + " 128x72\nview reset\nwait 1\nscreenshot " + reset + " 128x72\nquit\n");
+  const auto r = runViewer("--offscreen --size 160x90 --script " + script + " " + big_tck);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const test::Png a = test::readOurPng(before), b = test::readOurPng(after), c = test::readOurPng(reset);
+  ASSERT_GT(drawnPixels(a), 100u);
+  EXPECT_GE(agreeingDrawnFraction(a, b, 0), 0.999) << "the view changed when a model was added";
+  // The reset key still frames the default view: another picture.
+  EXPECT_LT(agreeingDrawnFraction(a, c, 0), 0.9);
+}
+
 TEST_F(GpuViewerBundling, splitViewFramesTheUnionOfItsModelsWhenTheCameraWasFramedOnTheSmaller) {
   const Tractogram big = test::smallTractogram(60, 3);
   Tractogram small = big;
@@ -280,7 +305,9 @@ TEST_F(GpuViewerBundling, splitViewFramesTheUnionOfItsModelsWhenTheCameraWasFram
                     script = dir_.file("s.txt");
   test::writeBytes(script, "wait-loaded\nview coronal\nset ssao off\nset fxaa off\nset orientation-labels off\n"
                            "set background 0,0,0\nmodel 0 hide\nopen " + small_tck + "\nwait-loaded\n"
-                           "split-view 0 1\nwait 2\nscreenshot " + split + " 128x72\nsplit-view off\n"
+                           // Adding a model keeps the view (framed on the big one): the reset
+                           // key frames the visible, smaller one.
+                           "view reset\nwait 2\nsplit-view 0 1\nwait 2\nscreenshot " + split + " 128x72\nsplit-view off\n"
                            "dolly " + dollyOut(4.0) + "\nshow-model 0\nwait 1\nscreenshot " + full0 + " 128x72\n"
                            "show-model 1\nwait 1\nscreenshot " + full1 + " 128x72\nquit\n");
   const auto r = runViewer("--offscreen --size 160x90 --script " + script + " " + big_tck);

@@ -291,8 +291,11 @@ TEST(OrbitController, refitWithinTheSceneKeepsTheView) {
   expectNear(after.target, before.target, 1e-9);
   expectNear(trueUp(after), trueUp(before), 1e-12);
   expectEnclosesBounds(after, inner);
+  expectNear(controller.fittedBounds().min, kBox.min, 0);  // the view is still fitted to the old box
+  expectNear(controller.fittedBounds().max, kBox.max, 0);
   // reset() now frames the new box: the default view of it.
   controller.reset();
+  expectNear(controller.fittedBounds().max, inner.max, 0);
   controller.update(2.0);
   OrbitController fresh;
   fresh.setViewport(320, 240);
@@ -319,6 +322,8 @@ TEST(OrbitController, refitBeyondTheSceneKeepsTheOrientationAndFramesTheNewBox) 
   expectNear(viewDirection(after), viewDirection(before), 1e-9);
   expectNear(trueUp(after), trueUp(before), 1e-9);
   expectEnclosesBounds(after, both);
+  expectNear(controller.fittedBounds().min, both.min, 0);
+  expectNear(controller.fittedBounds().max, both.max, 0);
   double extent = 0;
   for (const Vec3d& p : sample) {
     const auto w = project(after, p);

@@ -42,7 +42,7 @@ Vec3d axis(const Quat& q, const glm::dvec3& local) { return array(q * local); }
 
 OrbitController::OrbitController() {
   // A unit box at the origin until frame() gives the model's.
-  bounds_ = {{-50, -50, -50}, {50, 50, 50}};
+  bounds_ = fitted_bounds_ = {{-50, -50, -50}, {50, 50, 50}};
   goal_ = shown_ = defaultState();
 }
 
@@ -94,7 +94,7 @@ bool within(const Bounds& inner, const Bounds& outer, double slack) {
 }  // namespace
 
 void OrbitController::frame(const Bounds& bounds, std::span<const Vec3d> sample) {
-  bounds_ = usable(bounds);
+  bounds_ = fitted_bounds_ = usable(bounds);
   sample_.assign(sample.begin(), sample.end());
   goal_ = shown_ = defaultState();
   fitted_distance_ = goal_.distance;
@@ -108,11 +108,13 @@ void OrbitController::refit(const Bounds& bounds, std::span<const Vec3d> sample)
   if (!within(bounds_, old, kRefitSlack)) {
     const Quat kept = goal_.orientation;
     goal_ = fittedState(kept);
+    fitted_bounds_ = bounds_;
   }
   goal_.distance = clampDistance(goal_.distance);
 }
 
 void OrbitController::reset() {
+  fitted_bounds_ = bounds_;
   goal_ = defaultState();
   fitted_distance_ = goal_.distance;
 }

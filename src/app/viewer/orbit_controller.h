@@ -113,6 +113,10 @@ class OrbitController {
   Camera goalCamera(uint32_t width, uint32_t height) const;
 
   const Bounds& bounds() const { return bounds_; }
+  // The box the view's distance was last fitted to (frame(), reset(), a
+  // refit beyond the scene); after a refit that kept the view, the older
+  // box (the split view scales its halves by it).
+  const Bounds& fittedBounds() const { return fitted_bounds_; }
   Vec3d target() const { return shown_.target; }
   double distance() const { return shown_.distance; }
   double fittedDistance() const { return fitted_distance_; }
@@ -133,6 +137,7 @@ class OrbitController {
   double clampDistance(double distance) const;
 
   Bounds bounds_;
+  Bounds fitted_bounds_;
   std::vector<Vec3d> sample_;
   State shown_, goal_;
   double fitted_distance_ = 100;

@@ -821,7 +821,7 @@ FrameScene ViewerApp::modelScene(int model) {
 void ViewerApp::recordSplit(VkCommandBuffer cmd, const Camera& camera, const gpu::Buffer& out) {
   const int models[2] = {state_.split.left, state_.split.right};
   const Bounds shown = boundsUnion(scenes_[size_t(models[0])]->data->bounds, scenes_[size_t(models[1])]->data->bounds);
-  const double factor = splitDistanceFactor(controller_.bounds(), shown);
+  const double factor = splitDistanceFactor(controller_.fittedBounds(), shown);
   if (factor != split_reported_factor_) {
     // The halves' scale as drawn (a model added this frame is framed before
     // its first split frame), for the record and the tests.
