@@ -1,16 +1,15 @@
 #include "io/nifti_volume.h"
 
-#include <zlib.h>
 
 #include <algorithm>
 #include <cerrno>
-#include <climits>
 #include <filesystem>
 #include <memory>
 #include <nifti1.h>
 
 #include "core/byte_order.h"
 #include "core/error.h"
+#include "io/gzip_file.h"
 #include "io/nifti_header.h"
 
 namespace fibscope {
@@ -22,76 +21,6 @@ constexpr size_t kChunkBytes = size_t(1) << 20;
 // bytes cannot hold more than ~1032 n bytes, so a header claiming more is
 // refused before anything is read.
 constexpr uint64_t kMaxInflateRatio = 1032;
-
-// A file read through zlib, which reads plain and gzip files alike; every
-// failure is an Error naming the file and the (uncompressed) byte offset.
-class ZFile {
- public:
-  explicit ZFile(const std::string& path) : path_(path) {
-    std::error_code ec;
-    const auto status = std::filesystem::status(path, ec);
-    if (ec || !std::filesystem::exists(status)) {
-      errno = ec ? ec.value() : ENOENT;
-      failErrno(path, "cannot open");
-    }
-    if (!std::filesystem::is_regular_file(status)) fail(path, "not a regular file");
-    size_ = std::filesystem::file_size(path, ec);
-    if (ec) fail(path, "cannot read its size: " + ec.message());
-    file_ = gzopen(path.c_str(), "rb");
-    if (!file_) failErrno(path, "cannot open");
-  }
-  ~ZFile() { gzclose(file_); }
-  ZFile(const ZFile&) = delete;
-  ZFile& operator=(const ZFile&) = delete;
-
-  // Reads up to n bytes; fewer only at the end of the data. Throws for
-  // corrupt or cut gzip streams.
-  size_t read(void* buffer, size_t n) {
-    size_t done = 0;
-    while (done < n) {
-      const unsigned want = unsigned(std::min<size_t>(n - done, INT_MAX / 2));
-      const int got = gzread(file_, static_cast<char*>(buffer) + done, want);
-      if (got < 0) failStream();
-      done += size_t(got);
-      offset_ += uint64_t(got);
-      if (unsigned(got) < want) {
-        int code = Z_OK;
-        gzerror(file_, &code);
-        if (code == Z_BUF_ERROR) failAt(path_, offset_, "the gzip stream is cut short (unexpected end of file)");
-        if (code != Z_OK) failStream();
-        break;
-      }
-    }
-    return done;
-  }
-  // Reads and drops n bytes; returns how many there were.
-  uint64_t skip(uint64_t n, std::vector<unsigned char>& buffer) {
-    uint64_t done = 0;
-    while (done < n) {
-      const size_t want = size_t(std::min<uint64_t>(n - done, buffer.size()));
-      const size_t got = read(buffer.data(), want);
-      done += got;
-      if (got < want) break;
-    }
-    return done;
-  }
-  // Whether the file is gzip (valid after the first read).
-  bool compressed() const { return gzdirect(file_) == 0; }
-  uint64_t fileSize() const { return size_; }
-  uint64_t offset() const { return offset_; }
-
- private:
-  [[noreturn]] void failStream() {
-    int code = Z_OK;
-    const char* message = gzerror(file_, &code);
-    if (code == Z_ERRNO) failErrno(path_, "read error at byte " + std::to_string(offset_));
-    failAt(path_, offset_, std::string("corrupt gzip data (") + (message ? message : "zlib error") + ")");
-  }
-
-  std::string path_;
-  gzFile file_ = nullptr;
-  uint64_t size_ = 0, offset_ = 0;
-};
 
 bool endsWith(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
@@ -153,7 +82,7 @@ std::string describe(const NiftiHeader& h) {
 }  // namespace
 
 NiftiVolume loadNiftiVolume(const std::string& path, NiftiValues mode, const NiftiVoxelLimit& limit) {
-  ZFile file(path);
+  GzipFile file(path);
   unsigned char header_bytes[540];
   // sizeof_hdr first: a NIfTI-1 header is followed by data from byte 352 on,
   // so 540 bytes cannot be read blindly.
@@ -180,13 +109,13 @@ NiftiVolume loadNiftiVolume(const std::string& path, NiftiValues mode, const Nif
 
   // The voxels: in this file after the header (and its extensions, skipped),
   // or from the start of a separate .img.
-  std::unique_ptr<ZFile> image;
+  std::unique_ptr<GzipFile> image;
   std::string data_path = path;
   if (h.separate_image) {
     data_path = imagePathOf(path);
-    image = std::make_unique<ZFile>(data_path);
+    image = std::make_unique<GzipFile>(data_path);
   }
-  ZFile& data = image ? *image : file;
+  GzipFile& data = image ? *image : file;
   std::vector<unsigned char> buffer(kChunkBytes);
   const uint64_t start = uint64_t(h.vox_offset);  // >= the header's end in a single file
   const uint64_t before = start - data.offset();
