@@ -5,6 +5,11 @@
 // to RAS+ mm with nibabel's affine (io/trk_format.h), and lets the kernel
 // drop the pages it has passed. Every length is checked against the bytes
 // that remain before anything is read or allocated.
+//
+// A gzip-compressed file (DSI Studio's .trk.gz; told by its magic, not its
+// name) is walked the same way through a forward-only window on the
+// decompressed bytes (io/gzip_file.h): offsets in messages are those of the
+// decompressed data, progress (bytesRead) counts the compressed file's.
 #include <unistd.h>
 
 #include <bit>
@@ -13,6 +18,7 @@
 #include "core/byte_order.h"
 #include "core/error.h"
 #include "core/mapped_file.h"
+#include "io/gzip_file.h"
 #include "io/reader.h"
 #include "io/trk_format.h"
 
@@ -31,14 +37,19 @@ class TrkReader final : public TractogramReader {
  public:
   explicit TrkReader(const std::string& path);
   bool read(Tractogram& chunk, size_t max_points) override;
-  uint64_t bytesRead() const override { return pos_; }
+  uint64_t bytesRead() const override { return gz_ ? (done_ ? header_.file_bytes : gz_->file().fileOffset()) : pos_; }
 
  private:
-  void decodeStreamline(Tractogram& chunk, uint32_t m, uint64_t at) const;
-  [[noreturn]] void reportNonFinite(uint32_t m, uint64_t at) const;
+  // The bytes [pos_, pos_ + n) of the (decompressed) data where there are:
+  // how many (n, fewer only at the end); at() points into them.
+  uint64_t available(uint64_t n);
+  const uint8_t* at(uint64_t offset) const { return gz_ ? gz_->at(offset) : file_.data() + offset; }
+  void decodeStreamline(Tractogram& chunk, uint32_t m, uint64_t offset) const;
+  [[noreturn]] void reportNonFinite(uint32_t m, uint64_t start) const;
   void finishFile();
 
-  MappedFile file_;
+  MappedFile file_;                  // a plain file
+  std::unique_ptr<GzipWindow> gz_;   // or a gzip-compressed one
   TrkHeader trk_;
   Affine4 to_ras_{};
   bool swap_ = false;             // file byte order differs from the host's
@@ -53,11 +64,21 @@ class TrkReader final : public TractogramReader {
   bool done_ = false;
 };
 
-TrkReader::TrkReader(const std::string& path) : file_(path) {
+TrkReader::TrkReader(const std::string& path) {
   header_.path = path;
   header_.format = "trk";
-  header_.file_bytes = file_.size();
-  trk_ = parseTrkHeader(file_.data(), file_.size(), path);
+  if (isGzipFile(path)) {
+    gz_ = std::make_unique<GzipWindow>(path);
+    header_.file_bytes = gz_->file().fileSize();
+    pos_ = 0;
+    const size_t head = size_t(available(kTrkHeaderBytes));  // before at(): it may move the window
+    trk_ = parseTrkHeader(gz_->at(0), head, path);
+    pos_ = kTrkHeaderBytes;
+  } else {
+    file_ = MappedFile(path);
+    header_.file_bytes = file_.size();
+    trk_ = parseTrkHeader(file_.data(), file_.size(), path);
+  }
   swap_ = trk_.big_endian == kHostIsLittleEndian;
 
   std::vector<std::string> notes;
@@ -81,31 +102,41 @@ TrkReader::TrkReader(const std::string& path) : file_(path) {
 
   const long page = ::sysconf(_SC_PAGESIZE);
   if (page > 0) page_bytes_ = uint64_t(page);
-  file_.adviseSequential();
+  if (!gz_) file_.adviseSequential();
+}
+
+uint64_t TrkReader::available(uint64_t n) {
+  if (gz_) return gz_->ensure(pos_, n);
+  return std::min<uint64_t>(n, file_.size() - pos_);
 }
 
 bool TrkReader::read(Tractogram& chunk, size_t max_points) {
   startChunk(chunk);
   if (done_) return false;
-  const uint8_t* data = file_.data();
-  const uint64_t size = file_.size();
   while (!done_) {
-    const uint64_t remaining = size - pos_;
-    if (remaining == 0) {
+    const uint64_t head = available(4);
+    if (head == 0) {
       finishFile();
       break;
     }
-    if (remaining < 4) {
-      warn("byte " + std::to_string(pos_) + ": " + std::to_string(remaining) +
+    if (head < 4) {
+      warn("byte " + std::to_string(pos_) + ": " + std::to_string(head) +
            " trailing bytes are too few for a point count; ignored");
       finishFile();
       break;
     }
-    const int32_t m = loadUnaligned<int32_t>(data + pos_, swap_);
+    const int32_t m = loadUnaligned<int32_t>(at(pos_), swap_);
     if (m < 0)
       failAt(header_.path, pos_,
              "streamline " + std::to_string(streamlines_) + ": point count is " + std::to_string(m) + ", expected >= 0");
     const uint64_t need = 4 + uint64_t(m) * point_bytes_ + property_bytes_;
+    // Compressed, the bytes that remain are known only by decompressing
+    // them: a count no tracker makes is refused before the window grows.
+    if (gz_ && m > kMaxPlausiblePoints)
+      failAt(header_.path, pos_,
+             "streamline " + std::to_string(streamlines_) + ": point count " + std::to_string(m) +
+                 " is implausible (above " + std::to_string(kMaxPlausiblePoints) + ")");
+    const uint64_t remaining = available(need);
     if (need > remaining) {
       const std::string what = "streamline " + std::to_string(streamlines_) + " has " + std::to_string(m) +
                                " points and needs " + std::to_string(need) + " bytes, but only " +
@@ -121,15 +152,15 @@ bool TrkReader::read(Tractogram& chunk, size_t max_points) {
     if (chunk.pointCount() >= max_points) break;
   }
   // Hand the pages behind us back to the kernel: bounded memory on huge files.
-  if (pos_ - released_ >= page_bytes_) {
+  if (!gz_ && pos_ - released_ >= page_bytes_) {
     file_.release(released_, pos_);
     released_ = pos_ / page_bytes_ * page_bytes_;
   }
   return chunk.streamlineCount() > 0;
 }
 
-void TrkReader::decodeStreamline(Tractogram& chunk, uint32_t m, uint64_t at) const {
-  const uint8_t* p = file_.data() + at;
+void TrkReader::decodeStreamline(Tractogram& chunk, uint32_t m, uint64_t offset) const {
+  const uint8_t* p = at(offset);
   const size_t first_point = chunk.pointCount();
   chunk.positions.resize(3 * (first_point + m));
   float* out = chunk.positions.data() + 3 * first_point;
@@ -146,7 +177,7 @@ void TrkReader::decodeStreamline(Tractogram& chunk, uint32_t m, uint64_t at) con
     out[3 * j + 1] = static_cast<float>(a[4] * x + a[5] * y + a[6] * z + a[7]);
     out[3 * j + 2] = static_cast<float>(a[8] * x + a[9] * y + a[10] * z + a[11]);
   }
-  if (bad) reportNonFinite(m, at);
+  if (bad) reportNonFinite(m, offset);
 
   for (size_t r = 0; r < scalar_runs_.size(); ++r) {
     const TrkNamedRun& run = scalar_runs_[r];
@@ -168,18 +199,18 @@ void TrkReader::decodeStreamline(Tractogram& chunk, uint32_t m, uint64_t at) con
   chunk.offsets.push_back(first_point + m);
 }
 
-void TrkReader::reportNonFinite(uint32_t m, uint64_t at) const {
-  const uint8_t* p = file_.data() + at;
+void TrkReader::reportNonFinite(uint32_t m, uint64_t start) const {
+  const uint8_t* p = at(start);
   for (uint32_t j = 0; j < m; ++j)
     for (int k = 0; k < 3; ++k) {
-      const uint64_t offset = at + j * point_bytes_ + 4 * k;
+      const uint64_t offset = start + j * point_bytes_ + 4 * k;
       const uint32_t bits = loadUnaligned<uint32_t>(p + j * point_bytes_ + 4 * k, swap_);
       if (nonFinite(bits))
         failAt(header_.path, offset,
                "streamline " + std::to_string(streamlines_) + ": point " + std::to_string(j) + " coordinate " +
                    std::string(1, "xyz"[k]) + " is " + ((bits & 0x007fffffu) ? "NaN" : "infinite"));
     }
-  failAt(header_.path, at, "streamline " + std::to_string(streamlines_) + " has a non-finite coordinate");
+  failAt(header_.path, start, "streamline " + std::to_string(streamlines_) + " has a non-finite coordinate");
 }
 
 void TrkReader::finishFile() {

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <random>
 #include <sstream>
+#include <stdexcept>
 
 #include "core/error.h"
 #include "io/reader.h"
@@ -171,6 +172,22 @@ size_t drawnPixels(const Png& p) {
   size_t n = 0;
   for (size_t i = 0; i + 3 < p.rgba.size(); i += 4) n += p.rgba[i] + p.rgba[i + 1] + p.rgba[i + 2] > 30;
   return n;
+}
+
+std::string gzipBytes(const std::string& bytes, int level) {
+  z_stream z{};
+  // windowBits 15 + 16: the gzip header and trailer (CRC-32, size).
+  if (deflateInit2(&z, level, Z_DEFLATED, 15 + 16, 8, Z_DEFAULT_STRATEGY) != Z_OK) throw std::runtime_error("deflateInit2");
+  std::string out(deflateBound(&z, uLong(bytes.size())) + 32, '\0');
+  z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(bytes.data()));
+  z.avail_in = uInt(bytes.size());
+  z.next_out = reinterpret_cast<Bytef*>(out.data());
+  z.avail_out = uInt(out.size());
+  const int status = deflate(&z, Z_FINISH);
+  out.resize(z.total_out);
+  deflateEnd(&z);
+  if (status != Z_STREAM_END) throw std::runtime_error("deflate did not finish");
+  return out;
 }
 
 }  // namespace fibscope::test

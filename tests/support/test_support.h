@@ -41,6 +41,9 @@ std::string toolPath(const std::string& name);
 
 void writeBytes(const std::string& path, const std::string& bytes);
 std::string readBytes(const std::string& path);
+// `bytes` as a gzip file's bytes (zlib's deflate with the gzip wrapper, as
+// gzip(1) and Python's gzip module write them).
+std::string gzipBytes(const std::string& bytes, int level = 6);
 
 // A small deterministic tractogram: `streamlines` curved fibers of 2..60
 // points in a 100 mm box, with optional data arrays.
