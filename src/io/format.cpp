@@ -39,13 +39,15 @@ void TractogramReader::startChunk(Tractogram& chunk) const {
 std::unique_ptr<TractogramReader> openTractogram(const std::string& path) {
   const std::string ext = extensionOf(path);
   if (ext == ".gz") {
-    // DSI Studio saves .trk.gz; the .trk reader reads gzip (by its magic).
+    // DSI Studio saves .trk.gz and .tt.gz; both readers read gzip.
     // The others are mapped or read at offsets: say so rather than fail on
     // the compressed bytes.
     const std::string inner = extensionOf(path.substr(0, path.size() - 3));
     if (inner == ".trk") return openTrk(path);
-    fail(path, "a gzip-compressed '" + inner + "' file is not read (only .trk.gz is): decompress it first (gunzip -k)");
+    if (inner == ".tt") return openTinyTrack(path);  // DSI Studio's own format
+    fail(path, "a gzip-compressed '" + inner + "' file is not read (only .trk.gz and .tt.gz are): decompress it first (gunzip -k)");
   }
+  if (ext == ".tt") return openTinyTrack(path);
   if (ext == ".tck") return openTck(path);
   if (ext == ".trk") return openTrk(path);
   if (ext == ".trx") return openTrx(path);
@@ -53,7 +55,7 @@ std::unique_ptr<TractogramReader> openTractogram(const std::string& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec) && std::filesystem::exists(std::filesystem::path(path) / "header.json", ec))
     return openTrx(path);
-  fail(path, "unknown tractogram format '" + ext + "' (expected .tck, .trk, .trk.gz, .trx or .vtk)");
+  fail(path, "unknown tractogram format '" + ext + "' (expected .tck, .trk, .trk.gz, .tt.gz, .trx or .vtk)");
 }
 
 Tractogram readAllStreamlines(TractogramReader& reader) {

@@ -68,5 +68,7 @@ std::unique_ptr<TractogramReader> openTck(const std::string& path, const std::ve
 std::unique_ptr<TractogramReader> openTrk(const std::string& path);
 std::unique_ptr<TractogramReader> openTrx(const std::string& path);
 std::unique_ptr<TractogramReader> openVtk(const std::string& path);
+// DSI Studio's TinyTrack .tt.gz (or an uncompressed .tt): tt_reader.cpp.
+std::unique_ptr<TractogramReader> openTinyTrack(const std::string& path);
 
 }  // namespace fibscope
