@@ -12,41 +12,15 @@
 #include "core/error.h"
 #include "io/reader.h"
 #include "io/writer.h"
+#include "read_whole.h"
 #include "test_support.h"
 
 namespace fibscope {
 namespace {
 
-struct Read {
-  Tractogram all;
-  TractogramHeader header;
-  std::vector<std::string> warnings;
-  std::vector<uint64_t> progress;  // bytesRead after each chunk
-};
-
-Read readWhole(const std::string& path, size_t max_points) {
-  Read r;
-  auto reader = openTractogram(path);
-  Tractogram chunk;
-  while (reader->read(chunk, max_points)) {
-    EXPECT_EQ(chunk.validate(), "");
-    r.all.append(chunk);
-    r.progress.push_back(reader->bytesRead());
-  }
-  r.progress.push_back(reader->bytesRead());
-  r.header = reader->header();
-  r.warnings = reader->warnings();
-  return r;
-}
-
-std::string errorOf(const std::string& path) {
-  try {
-    readWhole(path, 1 << 16);
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using test::readWhole;
+using Read = test::WholeRead;
+std::string errorOf(const std::string& path) { return test::readError(path); }
 
 // Many short streamlines with a per-point and a per-streamline array, and
 // one of 300 k points (3.6 MB of records: several of the window's 1 MiB

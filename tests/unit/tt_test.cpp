@@ -13,6 +13,7 @@
 
 #include "core/error.h"
 #include "io/reader.h"
+#include "read_whole.h"
 #include "test_support.h"
 
 namespace fibscope {
@@ -25,34 +26,9 @@ bool hasScipy() {
   return ok;
 }
 
-struct Read {
-  Tractogram all;
-  TractogramHeader header;
-  std::vector<uint64_t> progress;
-};
-
-Read readWhole(const std::string& path, size_t max_points) {
-  Read r;
-  auto reader = openTractogram(path);
-  Tractogram chunk;
-  while (reader->read(chunk, max_points)) {
-    EXPECT_EQ(chunk.validate(), "");
-    r.all.append(chunk);
-    r.progress.push_back(reader->bytesRead());
-  }
-  r.progress.push_back(reader->bytesRead());
-  r.header = reader->header();
-  return r;
-}
-
-std::string errorOf(const std::string& path) {
-  try {
-    readWhole(path, 1 << 16);
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using test::readWhole;
+using Read = test::WholeRead;
+std::string errorOf(const std::string& path) { return test::readError(path); }
 
 TEST(TinyTrack, readsScipyWrittenFilesAsNumpyPlacesTheirPoints) {
   if (!hasScipy()) GTEST_SKIP() << kPython << " with numpy and scipy is missing (tests/tools/tt_make.py needs them)";
