@@ -53,4 +53,17 @@ inline void checkChunk(const TractogramReader& reader, const Tractogram& chunk) 
   if (reader.bytesRead() > reader.header().file_bytes) std::abort();
 }
 
+// Reads all of what open() returns, `max_points` at a time, checking each
+// chunk; an Error (thrown by open() or a read) is an accepted end.
+template <typename Open>
+void readAllChecked(Open open, size_t max_points) {
+  try {
+    auto reader = open();
+    Tractogram chunk;
+    while (reader->read(chunk, max_points)) checkChunk(*reader, chunk);
+  } catch (const Error& e) {
+    checkMessage(e);
+  }
+}
+
 }  // namespace fibscope::fuzz

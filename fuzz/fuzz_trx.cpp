@@ -18,13 +18,7 @@
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static const std::string path = fibscope::fuzz::scratchPath("trx", "input.trx");
   fibscope::fuzz::writeInput(path, data, size);
-  try {
-    auto reader = fibscope::openTrx(path);
-    fibscope::Tractogram chunk;
-    while (reader->read(chunk, 16)) fibscope::fuzz::checkChunk(*reader, chunk);
-  } catch (const fibscope::Error& e) {
-    fibscope::fuzz::checkMessage(e);
-  }
+  fibscope::fuzz::readAllChecked([&] { return fibscope::openTrx(path); }, 16);
   ::unlink(path.c_str());
   return 0;
 }

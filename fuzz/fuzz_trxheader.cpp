@@ -60,13 +60,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static const std::string dir = fibscope::fuzz::scratchPath("trxheader", "ref.trx");
   makeDirectory(dir);
   fibscope::fuzz::writeInput(dir + "/header.json", data, size);
-  try {
-    auto reader = fibscope::openTrx(dir);
-    fibscope::Tractogram chunk;
-    while (reader->read(chunk, 1)) fibscope::fuzz::checkChunk(*reader, chunk);
-  } catch (const fibscope::Error& e) {
-    fibscope::fuzz::checkMessage(e);
-  }
+  fibscope::fuzz::readAllChecked([&] { return fibscope::openTrx(dir); }, 1);
   removeDirectory(dir);
   return 0;
 }

@@ -18,13 +18,7 @@
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static const std::string path = fibscope::fuzz::scratchPath("tt", "input.tt");
   fibscope::fuzz::writeInput(path, data, size);
-  try {
-    auto reader = fibscope::openTinyTrack(path);
-    fibscope::Tractogram chunk;
-    while (reader->read(chunk, 64)) fibscope::fuzz::checkChunk(*reader, chunk);
-  } catch (const fibscope::Error& e) {
-    fibscope::fuzz::checkMessage(e);
-  }
+  fibscope::fuzz::readAllChecked([&] { return fibscope::openTinyTrack(path); }, 64);
   ::unlink(path.c_str());
   return 0;
 }
