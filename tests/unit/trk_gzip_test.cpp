@@ -87,6 +87,21 @@ TEST_F(TrkGzip, readsExactlyAsThePlainFileAtEveryChunkSize) {
   }
 }
 
+// The command line takes it as any input: `convert` of the .trk.gz writes
+// the bytes `convert` of the plain file writes.
+TEST_F(TrkGzip, convertWritesWhatThePlainFileGives) {
+  const std::string from_plain = dir_.file("plain.tck"), from_gz = dir_.file("gz.tck");
+  const auto a = test::runFibscope("convert " + plain_ + " " + from_plain);
+  const auto b = test::runFibscope("convert " + gz_ + " " + from_gz);
+  ASSERT_EQ(a.exit_code, 0) << a.output;
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  EXPECT_EQ(test::readBytes(from_gz), test::readBytes(from_plain));
+  test::writeBytes(dir_.file("t.tck.gz"), test::gzipBytes("mrtrix tracks\nEND\n"));
+  const auto bad = test::runFibscope("info " + dir_.file("t.tck.gz"));
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("decompress it first"), std::string::npos) << bad.output;
+}
+
 TEST_F(TrkGzip, theMagicDecidesNotTheName) {
   const Read want = readWhole(plain_, 1 << 16);
   const std::string gz_named_trk = dir_.file("gz.trk"), plain_named_gz = dir_.file("plain.trk.gz");
