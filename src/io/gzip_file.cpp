@@ -93,14 +93,16 @@ void GzipFile::failStream() {
 }
 
 uint64_t GzipWindow::ensure(uint64_t pos, uint64_t n) {
-  // Forget what lies before pos (a streamline or so is left: cheap to move).
-  if (pos > base_) {
-    const size_t drop = size_t(std::min<uint64_t>(pos - base_, filled_));
-    std::memmove(buffer_.data(), buffer_.data() + drop, filled_ - drop);
-    filled_ -= drop;
-    base_ += drop;
-  }
-  if (pos != base_) fail(file_.path(), "internal: the window went back");  // (pos < base_, or a gap)
+  if (pos < base_ || pos > base_ + filled_) fail(file_.path(), "internal: the window went back or skipped");
+  const uint64_t have = base_ + filled_ - pos;
+  if (have >= n || at_end_) return std::min(n, have);
+  // More is needed: only now forget what lies before pos (moving what is
+  // left, less than a record), not on every call, which would move the
+  // whole window once per streamline.
+  const size_t drop = size_t(pos - base_);
+  if (drop > 0) std::memmove(buffer_.data(), buffer_.data() + drop, filled_ - drop);  // (an empty buffer has no data())
+  filled_ -= drop;
+  base_ = pos;
   // Read in steps, growing by doubling only while data keeps coming.
   while (filled_ < n && !at_end_) {
     if (filled_ == buffer_.size()) buffer_.resize(std::max(buffer_.size() * 2, kFirstWindow));

@@ -11,6 +11,11 @@
 
 namespace fibscope {
 
+// Deflate's best ratio is 1032:1 (zlib's technical notes): a gzip file of n
+// bytes cannot hold more than ~1032 n bytes, so a header claiming more is
+// refused before anything is read (the NIfTI and TinyTrack readers).
+inline constexpr uint64_t kMaxGzipInflateRatio = 1032;
+
 // Whether the file at `path` starts with the gzip magic (1f 8b). False for
 // a file that cannot be read (its reader then says why).
 bool isGzipFile(const std::string& path);
@@ -56,9 +61,10 @@ class GzipWindow {
  public:
   explicit GzipWindow(const std::string& path) : file_(path) {}
 
-  // Makes the decompressed bytes [pos, pos + n) available, dropping those
-  // before `pos` (which must not go back past an earlier call's). Returns
-  // how many there are: n, fewer only at the end of the data.
+  // Makes the decompressed bytes [pos, pos + n) available; those before
+  // `pos` may be dropped (so `pos` must not go back past an earlier call's,
+  // nor beyond what that call made available). Returns how many there are:
+  // n, fewer only at the end of the data.
   uint64_t ensure(uint64_t pos, uint64_t n);
   // The byte at decompressed offset `pos`, within the last ensure()'s range.
   const uint8_t* at(uint64_t pos) const { return buffer_.data() + (pos - base_); }
