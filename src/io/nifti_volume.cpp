@@ -17,10 +17,6 @@ namespace {
 
 // Bytes read at a time: a multiple of every voxel size.
 constexpr size_t kChunkBytes = size_t(1) << 20;
-// Deflate's best ratio is 1032:1 (zlib's technical notes): a gzip file of n
-// bytes cannot hold more than ~1032 n bytes, so a header claiming more is
-// refused before anything is read.
-constexpr uint64_t kMaxInflateRatio = 1032;
 
 bool endsWith(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
@@ -129,7 +125,7 @@ NiftiVolume loadNiftiVolume(const std::string& path, NiftiValues mode, const Nif
       fail(data_path, "truncated: the header's " + describe(h) + " voxels need " + std::to_string(total_bytes) +
                           " bytes from byte " + std::to_string(start) + ", the file has " +
                           std::to_string(data.fileSize()) + " bytes");
-  } else if (double(start) + double(total_bytes) > double(kMaxInflateRatio) * double(data.fileSize()) + 65536.0) {
+  } else if (double(start) + double(total_bytes) > double(kMaxGzipInflateRatio) * double(data.fileSize()) + 65536.0) {
     fail(data_path, "truncated: the header's " + describe(h) + " voxels need " + std::to_string(total_bytes) +
                         " bytes, more than a gzip file of " + std::to_string(data.fileSize()) + " bytes can hold");
   }

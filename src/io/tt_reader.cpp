@@ -41,8 +41,6 @@ constexpr uint32_t kMaxNameBytes = 64;
 constexpr uint64_t kMaxSmallMatrixBytes = uint64_t(1) << 20;  // read whole; larger unknown ones are skipped
 constexpr uint64_t kSkipStep = uint64_t(1) << 20;
 constexpr uint64_t kTractHeaderBytes = 16;
-// Deflate's best ratio (zlib's technical notes), as the NIfTI reader uses it.
-constexpr uint64_t kMaxInflateRatio = 1032;
 
 // Bytes of one value of MAT-4 precision P (0 double, 1 single, 2 int32,
 // 3 int16, 4 uint16, 5 uint8); 0 for any other.
@@ -176,7 +174,7 @@ bool TinyTrackReader::nextMatrix(MatHeader& m) {
   m.data = pos_;
   m.end = m.data + m.bytes * (imaginary ? 2 : 1);
   // A deflate stream cannot hold more than 1032 times its size.
-  if (m.end > kMaxInflateRatio * header_.file_bytes + 65536)
+  if (m.end > kMaxGzipInflateRatio * header_.file_bytes + 65536)
     failHere(m.at, "matrix '" + m.name + "' claims " + std::to_string(m.bytes) + " bytes, more than a " +
                        std::to_string(header_.file_bytes) + "-byte gzip file can hold");
   return true;

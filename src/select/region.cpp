@@ -55,9 +55,10 @@ Region parseRegion(std::string_view spec) {
   const std::string_view values = colon == std::string_view::npos ? spec : spec.substr(colon + 1);
   std::vector<double> v;
   const bool numbers = parseNumberList(values, v);
-  // Coordinates and sizes (the first 6; an oriented box's angles are free).
+  // The first n values: coordinates and sizes (an oriented box's angles
+  // are free). Called once the count is checked.
   const auto checkRange = [&](size_t n) {
-    for (size_t i = 0; i < std::min(n, v.size()); ++i)
+    for (size_t i = 0; i < n; ++i)
       if (!(std::fabs(v[i]) <= kMaxRegionMm))
         fail(text, "a coordinate or size beyond " + number(kMaxRegionMm) + " mm (" + number(v[i]) + ")");
   };
