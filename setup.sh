@@ -11,7 +11,8 @@ case "$mode" in run|test) ;; *) echo "usage: $0 run|test" >&2; exit 2 ;; esac
 
 # Build and run-time packages (Debian 12 names).
 packages=(g++ cmake ninja-build pkg-config libgtest-dev libbenchmark-dev libcli11-dev
-          nlohmann-json3-dev libzip-dev zlib1g-dev libglm-dev libtinyobjloader-dev libnifti2-dev)
+          nlohmann-json3-dev libzip-dev zlib1g-dev libglm-dev libtinyobjloader-dev libnifti2-dev
+          libpugixml-dev liblz4-dev liblzma-dev)
 # Vulkan: loader and headers, the shader compiler, lavapipe (Vulkan on the CPU
 # where there is no GPU) and the validation layers (on in every GPU test);
 # spirv-val checks the task and mesh shaders lavapipe cannot run.
@@ -19,9 +20,11 @@ packages+=(libvulkan-dev glslc spirv-tools mesa-vulkan-drivers vulkan-validation
 # The viewer's window and panels (GLFW, Dear ImGui with its backend sources),
 # and a virtual X display for it where there is no screen.
 packages+=(libglfw3-dev libimgui-dev xvfb xauth)
-# Independent references for the tests (nibabel, MRtrix3, Embree for the SVO ray tracing) and the fuzzers (clang, libFuzzer).
+# Independent references for the tests (nibabel, MRtrix3, Embree for the SVO ray
+# tracing, VTK's own writers for the .vtk/.vtp readers) and the fuzzers (clang, libFuzzer).
 if [ "$mode" = test ]; then
-  packages+=(python3 python3-numpy python3-nibabel mrtrix3 clang libclang-rt-14-dev glslang-tools libembree-dev)
+  packages+=(python3 python3-numpy python3-nibabel mrtrix3 clang libclang-rt-14-dev glslang-tools libembree-dev
+            python3-vtk9)
 fi
 
 missing=()

@@ -34,7 +34,7 @@ void addBundleCommand(CLI::App& app) {
   auto opt = std::make_shared<Options>();
   BundleParams& p = opt->params;
   CLI::App* cmd = app.add_subcommand("bundle", "Bundle fibers on the GPU (density, constrained advection, smoothing)");
-  cmd->add_option("input", opt->input, "Input tractogram (.tck .trk .trk.gz .tt.gz .trx .vtk .fbl)")->required();
+  cmd->add_option("input", opt->input, "Input tractogram (.tck .trk .trk.gz .tt.gz .trx .vtk .vtp .fbl)")->required();
   cmd->add_option("output", opt->output, "Output tractogram (.tck .trk .trx .fbl)")->required();
   cmd->add_option("--radius", p.radius, "Kernel radius R of the first iteration, voxels")->capture_default_str();
   cmd->add_option("--iterations", p.iterations, "Iterations")->capture_default_str();

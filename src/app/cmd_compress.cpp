@@ -128,7 +128,7 @@ void addCompressCommand(CLI::App& app) {
   };
   auto opt = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand("compress", "Compress a tractogram into fiblets (.fbl)");
-  cmd->add_option("input", opt->input, "Input tractogram (.tck .trk .trk.gz .tt.gz .trx .vtk .fbl)")->required();
+  cmd->add_option("input", opt->input, "Input tractogram (.tck .trk .trk.gz .tt.gz .trx .vtk .vtp .fbl)")->required();
   cmd->add_option("output", opt->output, "Output .fbl file")->required();
   cmd->add_flag("--open-loop", opt->open_loop,
                 "Encode as the fiblets paper does (each direction quantised on its own) instead of closed loop");

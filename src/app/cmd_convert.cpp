@@ -20,7 +20,7 @@ void addConvertCommand(CLI::App& app) {
     bool trx_directory = false;
   };
   auto opt = std::make_shared<Options>();
-  CLI::App* cmd = app.add_subcommand("convert", "Convert between .tck, .trk, .trx (and read .vtk, .fbl)");
+  CLI::App* cmd = app.add_subcommand("convert", "Convert between .tck, .trk, .trx (and read .vtk, .vtp, .tt.gz, .fbl)");
   cmd->add_option("input", opt->input, "Input tractogram")->required();
   cmd->add_option("output", opt->output, "Output tractogram (.tck .trk .trx)")->required();
   cmd->add_flag("--force,-f", opt->force, "Overwrite the output if it exists");

@@ -94,7 +94,7 @@ void addFilterCommand(CLI::App& app) {
   auto o = std::make_shared<FilterOptions>();
   CLI::App* cmd = app.add_subcommand(
       "filter", "Keep the streamlines that pass regions of interest, length limits and per-streamline scalar ranges (regions and lengths as MRtrix3's tckedit)");
-  cmd->add_option("input", o->input, "Input tractogram (.tck .trk .trk.gz .tt.gz .trx .vtk .fbl)")->required();
+  cmd->add_option("input", o->input, "Input tractogram (.tck .trk .trk.gz .tt.gz .trx .vtk .vtp .fbl)")->required();
   cmd->add_option("output", o->output, "Output tractogram (.tck .trk .trx)")->required();
   addCriteriaCliOptions(cmd, o->criteria);
   cmd->add_option("--threads", o->threads, "Threads testing the streamlines (0: every core)");

@@ -292,7 +292,7 @@ void addInfoCommand(CLI::App& app) {
   };
   auto opt = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand("info", "Counts, step, turning angle, extent and data of tractogram files");
-  cmd->add_option("files", opt->files, "Tractogram files (.tck .trk .trk.gz .tt.gz .trx .vtk .fbl)")->required();
+  cmd->add_option("files", opt->files, "Tractogram files (.tck .trk .trk.gz .tt.gz .trx .vtk .vtp .fbl)")->required();
   cmd->add_flag("--json", opt->json, "Print one JSON document for all files");
   cmd->add_option("--density-voxel", opt->density_voxel_mm,
                   "Voxel size in mm of the fiber density statistic (distinct fibers per occupied voxel); 0: off")

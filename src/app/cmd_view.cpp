@@ -125,7 +125,7 @@ void addViewCommand(CLI::App& app) {
   addRenderCliOptions(cmd, o->render);
   // The viewer opens several files: the positional takes them all.
   cmd->remove_option(cmd->get_option("input"));
-  cmd->add_option("files", o->files, "Tractograms (.tck .trk .trk.gz .tt.gz .trx .vtk .fbl); none: the built-in phantom");
+  cmd->add_option("files", o->files, "Tractograms (.tck .trk .trk.gz .tt.gz .trx .vtk .vtp .fbl); none: the built-in phantom");
   cmd->add_option("--screenshot", o->screenshot, "Write the window (panels included) to this PNG after the last frame");
   cmd->add_option("--frames", o->frames, "Render this many frames, then exit");
   cmd->add_option("--script", o->script, "Run viewer commands from this file (one a line)");

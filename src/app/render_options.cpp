@@ -32,7 +32,7 @@ bool negatedFlag(const SettingInfo& info, const RenderSettings& defaults) {
 }  // namespace
 
 void addRenderCliOptions(CLI::App* cmd, RenderCliOptions& o) {
-  cmd->add_option("input", o.input, "Tractogram (.tck .trk .trk.gz .tt.gz .trx .vtk .fbl); none: the built-in phantom");
+  cmd->add_option("input", o.input, "Tractogram (.tck .trk .trk.gz .tt.gz .trx .vtk .vtp .fbl); none: the built-in phantom");
   cmd->add_option("--phantom-streamlines", o.phantom_streamlines, "Streamlines of the built-in phantom")
       ->capture_default_str();
   cmd->add_option("--size", o.size, "Frame size WxH in pixels")->capture_default_str();

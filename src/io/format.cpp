@@ -52,10 +52,11 @@ std::unique_ptr<TractogramReader> openTractogram(const std::string& path) {
   if (ext == ".trk") return openTrk(path);
   if (ext == ".trx") return openTrx(path);
   if (ext == ".vtk") return openVtk(path);
+  if (ext == ".vtp") return openVtp(path);
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec) && std::filesystem::exists(std::filesystem::path(path) / "header.json", ec))
     return openTrx(path);
-  fail(path, "unknown tractogram format '" + ext + "' (expected .tck, .trk, .trk.gz, .tt.gz, .trx or .vtk)");
+  fail(path, "unknown tractogram format '" + ext + "' (expected .tck, .trk, .trk.gz, .tt.gz, .trx, .vtk or .vtp)");
 }
 
 Tractogram readAllStreamlines(TractogramReader& reader) {

@@ -44,7 +44,7 @@ class TractogramReader {
   std::vector<std::string> warnings_;
 };
 
-// Opens `path` by its extension (.tck, .trk, .trx or a TRX directory, .vtk;
+// Opens `path` by its extension (.tck, .trk, .trx or a TRX directory, .vtk, .vtp;
 // .tsf is not a tractogram). Throws Error for unknown extensions and for
 // headers that cannot be parsed.
 std::unique_ptr<TractogramReader> openTractogram(const std::string& path);
@@ -68,6 +68,8 @@ std::unique_ptr<TractogramReader> openTck(const std::string& path, const std::ve
 std::unique_ptr<TractogramReader> openTrk(const std::string& path);
 std::unique_ptr<TractogramReader> openTrx(const std::string& path);
 std::unique_ptr<TractogramReader> openVtk(const std::string& path);
+// VTK XML PolyData (.vtp): vtp_reader.cpp.
+std::unique_ptr<TractogramReader> openVtp(const std::string& path);
 // DSI Studio's TinyTrack .tt.gz (or an uncompressed .tt): tt_reader.cpp.
 std::unique_ptr<TractogramReader> openTinyTrack(const std::string& path);
 

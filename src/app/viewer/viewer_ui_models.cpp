@@ -135,7 +135,7 @@ void modelList(ViewerState& state, std::vector<ViewerAction>& actions) {
 
 void openSection(ViewerState& state, std::vector<ViewerAction>& actions) {
   ImGui::SetNextItemWidth(-60);
-  const bool enter = ImGui::InputTextWithHint("##path", "file.tck / .trk(.gz) / .tt.gz / .trx / .vtk / .fbl", &state.open_path,
+  const bool enter = ImGui::InputTextWithHint("##path", "file.tck / .trk(.gz) / .tt.gz / .trx / .vtk / .vtp / .fbl", &state.open_path,
                                               ImGuiInputTextFlags_EnterReturnsTrue);
   ImGui::SameLine();
   if ((ImGui::Button("Open") || enter) && !state.open_path.empty()) actions.push_back(OpenAction{state.open_path});
