@@ -339,7 +339,12 @@ void VtpReader::parsePiece(const pugi::xml_node& piece, size_t index) {
         continue;
       }
       if (name.empty()) name = std::string(section) + "_" + std::to_string(k);
-      for (int n = 2; seen.count(name); ++n) name = array.attribute("Name").as_string() + ("_" + std::to_string(n));
+      const std::string base = name;
+      for (int n = 2; seen.count(name); ++n) {
+        name = base;
+        name.push_back('_');
+        name.append(std::to_string(n));
+      }
       seen.insert(name);
       if (index == 0) {
         arrays.push_back({name, uint32_t(components), vtp::dtypeName(type), {}});

@@ -144,7 +144,7 @@ TEST(VtpReader, malformedFilesGetOneLineNamingTheProblem) {
       {withReplaced(kAscii, "type=\"Int64\" Name=\"offsets\"", "type=\"Float32\" Name=\"offsets\""), "integer type"},
       {withReplaced(kAscii, "type=\"Float32\" Name=\"fa\"", "type=\"Quad\" Name=\"fa\""), "'Quad' is not a VTK XML type"},
       {withReplaced(kAscii, "byte_order=\"LittleEndian\"", "byte_order=\"Middle\""), "byte_order 'Middle'"},
-      {withReplaced(kAscii, "version=\"1.0\"", "version=\"1.0\" compressor=\"vtkFooCompressor\""), "compressor"},
+      {withReplaced(kAscii, "byte_order=", "compressor=\"vtkFooCompressor\" byte_order="), "compressor 'vtkFooCompressor'"},
       {withReplaced(kAscii, "format=\"ascii\">0 0 0", "format=\"appended\" offset=\"0\">0 0 0"), "no <AppendedData>"},
       {withReplaced(kAscii, "format=\"ascii\">0 0 0  1 0 0  2 0 0  0 5 0", "format=\"binary\">AAAA!!!!"),
        "not base64"},
