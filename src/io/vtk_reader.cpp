@@ -404,9 +404,9 @@ class VtkReader final : public TractogramReader {
   bool have_lines_ = false;
   CellArray lines_;
   uint64_t other_cells_ = 0;          // vertices, polygons, strips: not streamlines
+  uint64_t vertex_cells_ = 0;         // of those, vertices (numbered before the lines)
   std::vector<DataArray> point_arrays_;  // values per point id
   std::vector<DataArray> line_arrays_;   // values per line cell
-  bool cell_data_warned_ = false;
   uint64_t header_end_ = 0;
   uint64_t next_line_ = 0;
   bool lps_ = false;  // points are stored in LPS: negate x and y
@@ -478,6 +478,7 @@ void VtkReader::parse(VtkCursor& c) {
         lines_ = std::move(cells);
       } else {
         other_cells_ += cells.cellCount();
+        if (keyword == "vertices") vertex_cells_ += cells.cellCount();
         if (cells.cellCount() > 0)
           warn(std::to_string(cells.cellCount()) + " " + keyword + " cells are not streamlines; skipped");
       }
@@ -731,13 +732,6 @@ void VtkReader::readArray(VtkCursor& c, std::string name, const ValueType& type,
     warn(what + " skipped (bit and string arrays are not numeric data)");
     return;
   }
-  if (owner == Owner::kCells && other_cells_ > 0) {
-    c.skipValues(type, tuples * components, what);
-    if (!cell_data_warned_)
-      warn("CELL_DATA skipped: the file has cells other than lines, so its values do not map to streamlines");
-    cell_data_warned_ = true;
-    return;
-  }
   const uint64_t n = tuples * components;
   if (n > (c.binary() ? c.remaining() / type.bytes : c.remaining()))
     c.fail(what + ": " + std::to_string(n) + " values need more bytes than the " + std::to_string(c.remaining()) +
@@ -748,6 +742,13 @@ void VtkReader::readArray(VtkCursor& c, std::string name, const ValueType& type,
   c.readValues(type, n, array.values.data(), what);
   if (color && c.binary())
     for (float& v : array.values) v /= 255.0f;  // binary colour scalars are bytes, ASCII ones 0..1
+  if (owner == Owner::kCells && other_cells_ > 0) {
+    // vtkPolyData numbers its cells verts, lines, polys, strips, whatever
+    // order the sections come in: the lines' rows follow the vertices.
+    const uint64_t lines = lines_.cellCount();
+    array.values.erase(array.values.begin() + (vertex_cells_ + lines) * components, array.values.end());
+    array.values.erase(array.values.begin(), array.values.begin() + vertex_cells_ * components);
+  }
   std::vector<DataArray>& arrays = owner == Owner::kPoints ? point_arrays_ : line_arrays_;
   if (array.name.empty()) array.name = "array_" + std::to_string(arrays.size());
   std::unordered_set<std::string> used;

@@ -134,7 +134,7 @@ TEST(VtkReader, chunksHoldWholeStreamlines) {
   EXPECT_EQ(reader->bytesRead(), std::string(kClassicAscii).size());
 }
 
-TEST(VtkReader, skipsPolygonsAndWarnsOnce) {
+TEST(VtkReader, skipsPolygonsAndKeepsTheLinesCellData) {
   TempDir dir;
   const std::string text =
       "# vtk DataFile Version 3.0\nmixed\nASCII\nDATASET POLYDATA\n"
@@ -146,10 +146,11 @@ TEST(VtkReader, skipsPolygonsAndWarnsOnce) {
   std::vector<std::string> warnings;
   ASSERT_EQ(readAll(save(dir, text), &t, &warnings), "");
   EXPECT_EQ(t.streamlineCount(), 1u);
-  EXPECT_TRUE(t.per_streamline.empty());
-  EXPECT_EQ(warnings.size(), 2u) << ::testing::PrintToString(warnings);
+  // Cells are numbered verts, lines, polys, strips: the line is row 0.
+  ASSERT_EQ(t.per_streamline.size(), 1u);
+  EXPECT_EQ(t.per_streamline[0].values, std::vector<float>{1.0f});
+  EXPECT_EQ(warnings.size(), 1u) << ::testing::PrintToString(warnings);
   EXPECT_TRUE(anyContains(warnings, "1 polygons cells"));
-  EXPECT_TRUE(anyContains(warnings, "CELL_DATA skipped"));
 }
 
 TEST(VtkReader, readsBinaryClassicFileBuiltByHand) {
