@@ -44,6 +44,7 @@ class ByteStream {
   }
 
   void read(uint8_t* out, uint64_t n, const char* part) {
+    if (n == 0) return;  // an empty array: `out` may be null
     if (!s_.base64) {
       if (n > s_.size - pos_) fail(part, "ends " + std::to_string(n - (s_.size - pos_)) + " bytes early");
       std::memcpy(out, s_.data + pos_, n);
@@ -100,7 +101,7 @@ class ByteStream {
 };
 
 uint64_t headerWord(ByteStream& in, const Encoding& e, const char* part) {
-  uint8_t b[8];
+  uint8_t b[8] = {};
   in.read(b, e.header_bytes, part);
   return e.header_bytes == 8 ? loadUnaligned<uint64_t>(b, e.swap) : loadUnaligned<uint32_t>(b, e.swap);
 }

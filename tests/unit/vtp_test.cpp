@@ -183,6 +183,20 @@ TEST(VtpReader, everyTruncatedPrefixOfARealFileFailsCleanly) {
   }
 }
 
+// An empty appended raw array (a UInt32 header of 0, no bytes): read as
+// empty, not a copy from a null pointer (found by fuzz_vtp under UBSan).
+TEST(VtpReader, emptyAppendedArraysReadAsEmpty) {
+  const std::string text = std::string(
+      "<VTKFile type=\"PolyData\" byte_order=\"LittleEndian\"><PolyData><Piece NumberOfPoints=\"0\">"
+      "<PointData><DataArray type=\"Float32\" Name=\"fa\" format=\"appended\" offset=\"0\"/></PointData>"
+      "</Piece></PolyData><AppendedData encoding=\"raw\">_") + std::string(4, '\0') + "</AppendedData></VTKFile>";
+  TempDir dir;
+  test::writeBytes(dir.file("e.vtp"), text);
+  Tractogram t;
+  ASSERT_EQ(readAll(dir.file("e.vtp"), &t), "");
+  EXPECT_EQ(t.streamlineCount(), 0u);
+}
+
 TEST(VtpReader, openTractogramDispatchesVtpByExtension) {
   TempDir dir;
   test::writeBytes(dir.file("x.VTP"), kAscii);
