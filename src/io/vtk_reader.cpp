@@ -29,6 +29,7 @@
 #include "core/byte_order.h"
 #include "core/error.h"
 #include "core/mapped_file.h"
+#include "io/indexed_lines.h"
 #include "io/reader.h"
 
 namespace fibscope {
@@ -775,37 +776,17 @@ bool VtkReader::read(Tractogram& chunk, size_t max_points) {
   startChunk(chunk);
   const uint64_t lines = lines_.cellCount();
   if (next_line_ >= lines) return false;
+  const IndexedPoints src{header_.path, points_, point_arrays_, line_arrays_, lps_};
   while (next_line_ < lines) {
     const uint64_t i = next_line_;
-    const uint64_t k = lines_.offsets[i + 1] - lines_.offsets[i];
-    const size_t first = chunk.pointCount();
-    chunk.positions.resize(3 * (first + k));
-    float* out = chunk.positions.data() + 3 * first;
-    for (uint64_t j = 0; j < k; ++j) {
+    appendIndexedLine(chunk, src, i, lines_.offsets[i + 1] - lines_.offsets[i], [&](uint64_t j) {
       const int64_t id = lines_.id(i, j);
       if (id < 0 || uint64_t(id) >= point_count_)
         failAt(header_.path, lines_.entryOffset(i, j),
                "line " + std::to_string(i) + " point " + std::to_string(j) + " refers to point " + std::to_string(id) +
                    ", but POINTS has " + std::to_string(point_count_));
-      const float* p = points_.data() + 3 * id;
-      if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
-        fail(header_.path, "line " + std::to_string(i) + " uses point " + std::to_string(id) +
-                               ", which has a non-finite coordinate");
-      out[3 * j + 0] = lps_ ? -p[0] : p[0];
-      out[3 * j + 1] = lps_ ? -p[1] : p[1];
-      out[3 * j + 2] = p[2];
-      for (size_t a = 0; a < point_arrays_.size(); ++a) {
-        const uint32_t n = point_arrays_[a].components;
-        const float* v = point_arrays_[a].values.data() + uint64_t(id) * n;
-        chunk.per_point[a].values.insert(chunk.per_point[a].values.end(), v, v + n);
-      }
-    }
-    for (size_t a = 0; a < line_arrays_.size(); ++a) {
-      const uint32_t n = line_arrays_[a].components;
-      const float* v = line_arrays_[a].values.data() + i * n;
-      chunk.per_streamline[a].values.insert(chunk.per_streamline[a].values.end(), v, v + n);
-    }
-    chunk.offsets.push_back(first + k);
+      return uint64_t(id);
+    });
     ++next_line_;
     if (chunk.pointCount() >= max_points) break;
   }

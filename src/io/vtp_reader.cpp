@@ -34,6 +34,7 @@
 #include "core/byte_order.h"
 #include "core/error.h"
 #include "core/mapped_file.h"
+#include "io/indexed_lines.h"
 #include "io/reader.h"
 #include "io/vtp_data.h"
 
@@ -368,33 +369,11 @@ bool VtpReader::read(Tractogram& chunk, size_t max_points) {
   startChunk(chunk);
   const uint64_t lines = line_offsets_.size() - 1;
   if (next_line_ >= lines) return false;
+  const IndexedPoints src{header_.path, points_, point_arrays_, line_arrays_, lps_};
   while (next_line_ < lines) {
-    const uint64_t i = next_line_;
-    const uint64_t begin = line_offsets_[i], k = line_offsets_[i + 1] - begin;
-    const size_t first = chunk.pointCount();
-    chunk.positions.resize(3 * (first + k));
-    float* out = chunk.positions.data() + 3 * first;
-    for (uint64_t j = 0; j < k; ++j) {
-      const uint64_t id = line_ids_[begin + j];
-      const float* p = points_.data() + 3 * id;
-      if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
-        fail(header_.path, "line " + std::to_string(i) + " uses point " + std::to_string(id) +
-                               ", which has a non-finite coordinate");
-      out[3 * j + 0] = lps_ ? -p[0] : p[0];
-      out[3 * j + 1] = lps_ ? -p[1] : p[1];
-      out[3 * j + 2] = p[2];
-      for (size_t a = 0; a < point_arrays_.size(); ++a) {
-        const uint32_t n = point_arrays_[a].components;
-        const float* v = point_arrays_[a].values.data() + id * n;
-        chunk.per_point[a].values.insert(chunk.per_point[a].values.end(), v, v + n);
-      }
-    }
-    for (size_t a = 0; a < line_arrays_.size(); ++a) {
-      const uint32_t n = line_arrays_[a].components;
-      const float* v = line_arrays_[a].values.data() + i * n;
-      chunk.per_streamline[a].values.insert(chunk.per_streamline[a].values.end(), v, v + n);
-    }
-    chunk.offsets.push_back(first + k);
+    const uint64_t i = next_line_, begin = line_offsets_[i];
+    // Ids were checked against their piece's points when parsed.
+    appendIndexedLine(chunk, src, i, line_offsets_[i + 1] - begin, [&](uint64_t j) { return line_ids_[begin + j]; });
     ++next_line_;
     if (chunk.pointCount() >= max_points) break;
   }
