@@ -2,6 +2,7 @@
 
 #include <sys/wait.h>
 #include <unistd.h>
+#include <gtest/gtest.h>
 #include <zlib.h>
 
 #include <algorithm>
@@ -188,6 +189,27 @@ std::string gzipBytes(const std::string& bytes, int level) {
   deflateEnd(&z);
   if (status != Z_STREAM_END) throw std::runtime_error("deflate did not finish");
   return out;
+}
+
+std::string readChunked(const std::function<std::unique_ptr<TractogramReader>()>& open, Tractogram* out,
+                        std::vector<std::string>* warnings, TractogramHeader* header, size_t max_points) {
+  try {
+    auto reader = open();
+    Tractogram all, chunk;
+    for (const auto& a : reader->header().per_point) all.per_point.push_back({a.name, a.components, a.dtype, {}});
+    for (const auto& a : reader->header().per_streamline)
+      all.per_streamline.push_back({a.name, a.components, a.dtype, {}});
+    while (reader->read(chunk, max_points)) {
+      EXPECT_EQ(chunk.validate(), "");
+      all.append(chunk);
+    }
+    if (out) *out = all;
+    if (warnings) *warnings = reader->warnings();
+    if (header) *header = reader->header();
+    return {};
+  } catch (const Error& e) {
+    return e.what();
+  }
 }
 
 }  // namespace fibscope::test

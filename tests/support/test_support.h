@@ -4,10 +4,12 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "core/tractogram.h"
+#include "io/reader.h"
 
 namespace fibscope::test {
 
@@ -55,6 +57,13 @@ std::string writePhantomTck(const TempDir& dir, const std::string& name, uint64_
 
 // The message of the Error `f` throws; empty when it throws none.
 std::string errorOf(const std::function<void()>& f);
+
+// Opens a reader with `open` and reads it all, `max_points` at a time,
+// checking each chunk's invariants (EXPECT); "" or the Error's message.
+// The tractogram, warnings and header go where given.
+std::string readChunked(const std::function<std::unique_ptr<TractogramReader>()>& open, Tractogram* out = nullptr,
+                        std::vector<std::string>* warnings = nullptr, TractogramHeader* header = nullptr,
+                        size_t max_points = size_t(1) << 20);
 
 // An 8-bit RGBA image read from a PNG.
 struct Png {

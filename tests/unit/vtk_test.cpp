@@ -20,23 +20,7 @@ using Json = nlohmann::json;
 
 std::string readAll(const std::string& path, Tractogram* out = nullptr, std::vector<std::string>* warnings = nullptr,
                     TractogramHeader* header = nullptr, size_t max_points = size_t(1) << 20) {
-  try {
-    auto reader = openVtk(path);
-    Tractogram all, chunk;
-    for (const auto& a : reader->header().per_point) all.per_point.push_back({a.name, a.components, a.dtype, {}});
-    for (const auto& a : reader->header().per_streamline)
-      all.per_streamline.push_back({a.name, a.components, a.dtype, {}});
-    while (reader->read(chunk, max_points)) {
-      EXPECT_EQ(chunk.validate(), "");
-      all.append(chunk);
-    }
-    if (out) *out = all;
-    if (warnings) *warnings = reader->warnings();
-    if (header) *header = reader->header();
-    return {};
-  } catch (const Error& e) {
-    return e.what();
-  }
+  return test::readChunked([&] { return openVtk(path); }, out, warnings, header, max_points);
 }
 
 std::string save(const TempDir& dir, const std::string& text, const std::string& name = "t.vtk") {
